@@ -1,0 +1,179 @@
+"""The ``nairnmpm`` command: a thin layer over the package's functions.
+
+Exit codes: 0 done, 2 bad input, 3 the simulation went unstable, 130 interrupted.
+"""
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+from . import __version__
+
+EXIT_OK, EXIT_INPUT, EXIT_UNSTABLE, EXIT_INTERRUPTED = 0, 2, 3, 130
+
+
+def default_results_dir(input_path: Path) -> Path:
+    """Results go next to the input, named after it: ``bar.xml`` -> ``bar_results``."""
+    return input_path.with_name(input_path.stem + "_results")
+
+
+def _print_problems(exc) -> None:
+    for p in exc.problems:
+        print(p, file=sys.stderr)
+
+
+def _summary(sim) -> str:
+    from .core.simulation import METHOD_NAMES, SHAPE_NAMES
+    p, g = sim.particles, sim.grid
+    lines = [
+        f"title:      {sim.title.splitlines()[0] if sim.title else '(none)'}",
+        f"analysis:   {'plane stress' if sim.plane_stress else 'plane strain'}, "
+        f"{METHOD_NAMES[sim.method]}{'+' if sim.post_extrapolate and sim.method != 0 else ''}"
+        f", {SHAPE_NAMES[sim.shape]} shape functions",
+        f"particles:  {p.n}",
+        f"grid:       {g.nx} x {g.ny} cells of {g.dx:g} x {g.dy:g} mm "
+        f"({g.xmin:g} to {g.xmax:g}, {g.ymin:g} to {g.ymax:g} mm), thickness {g.thickness:g} mm",
+        "materials:  " + "; ".join(f"{n} ({m.name}, {int((p.mat == i).sum())} particles, "
+                                   f"wave speed {m.wave_speed():.4g} m/s)"
+                                   for i, (n, m) in enumerate(zip(sim.material_names, sim.materials))),
+        "cracks:     none",
+        f"time step:  {sim.dt:.6g} ms (CFL limit {sim.cfl_time_step():.6g} ms at factor {sim.cfl:g})",
+        f"max time:   {sim.max_time:g} ms, about {sim.n_steps} steps",
+        f"conditions: {len(sim.conditions.records)} ("
+        + ", ".join(r.name for r in sim.conditions.records) + ")",
+    ]
+    return "\n".join(lines)
+
+
+def cmd_check(args) -> int:
+    from .errors import InputError
+    from .input import load_simulation
+    try:
+        sim = load_simulation(args.file)
+    except InputError as exc:
+        _print_problems(exc)
+        return EXIT_INPUT
+    print(_summary(sim))
+    return EXIT_OK
+
+
+def cmd_run(args) -> int:
+    from .errors import InputError, SimulationUnstable
+    from .input import load_simulation
+    from .outputs.defaults import default_outputs
+    path = Path(args.file)
+    try:
+        sim = load_simulation(path)
+    except InputError as exc:
+        _print_problems(exc)
+        return EXIT_INPUT
+    out = Path(args.output) if args.output else default_results_dir(path)
+    if out.exists():
+        if not args.force:
+            print(f"{out}: results folder exists; use --force to replace it", file=sys.stderr)
+            return EXIT_INPUT
+        if out.is_dir() and ((out / "run.json").exists() or not any(out.iterdir())):
+            shutil.rmtree(out)
+        else:
+            print(f"{out}: exists and is not a results folder; not replacing it", file=sys.stderr)
+            return EXIT_INPUT
+    out.mkdir(parents=True)
+    outputs = default_outputs(out)
+    show = not args.quiet and sys.stderr.isatty()
+    bar = None
+    if show:
+        from tqdm import tqdm
+        bar = tqdm(total=sim.n_steps, unit="step", dynamic_ncols=True, file=sys.stderr,
+                   bar_format="{l_bar}{bar}| {n_fmt}/{total_fmt} steps [{elapsed}<{remaining}, "
+                              "{rate_fmt}]{postfix}")
+
+    def progress(fraction, time_ms, step, rate):
+        if bar is not None:
+            bar.n = step
+            bar.set_postfix_str(f"t = {time_ms:.4g} ms", refresh=False)
+            bar.refresh()
+    if not args.quiet:
+        print(_summary(sim), file=sys.stderr)
+    try:
+        status = sim.run(outputs, progress=progress)
+    except SimulationUnstable as exc:
+        if bar is not None:
+            bar.close()
+        print(f"{path}: {exc}; results so far are in {out}", file=sys.stderr)
+        return EXIT_UNSTABLE
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
+        print(f"\ninterrupted; results so far are in {out}", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if bar is not None:
+        bar.close()
+    if not args.quiet:
+        print(f"done: {sim.step} steps in {status['wall_seconds']:.2f} s; results in {out}",
+              file=sys.stderr)
+    return EXIT_OK
+
+
+def cmd_plugins(args) -> int:
+    from . import plugins
+    from .errors import PluginError
+    rows = []
+    status = EXIT_OK
+    for short, group in plugins.GROUPS.items():
+        try:
+            for p in plugins.registry(short):
+                rows.append((group, p.name, "" if p.nairn_type is None else str(p.nairn_type), p.package))
+        except PluginError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            status = EXIT_INPUT
+    head = ("group", "name", "type", "package")
+    widths = [max(len(r[i]) for r in rows + [head]) for i in range(4)]
+    for r in [head] + rows:
+        print("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
+    return status
+
+
+def cmd_plot(args) -> int:
+    from .analysis.plots import plot_results
+    folder = Path(args.dir)
+    if not (folder / "run.json").exists() and not (folder / "global.csv").exists():
+        print(f"{folder}: not a results folder (no run.json or global.csv)", file=sys.stderr)
+        return EXIT_INPUT
+    files = plot_results(folder, Path(args.output) if args.output else None)
+    for f in files:
+        print(f)
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="nairnmpm", description="MPM fracture simulations from "
+                                 "NairnMPM-style XML input files.")
+    ap.add_argument("--version", action="version", version=f"nairnmpm_py {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="run a simulation")
+    p.add_argument("file", help="input file (.xml, or NairnMPM's XML .fmcmd)")
+    p.add_argument("-o", "--output", help="results folder (default: next to FILE, FILE_results)")
+    p.add_argument("--force", action="store_true", help="replace an existing results folder")
+    p.add_argument("-q", "--quiet", action="store_true", help="no summary or progress bar")
+    p.set_defaults(func=cmd_run)
+    p = sub.add_parser("check", help="parse and validate only; print a summary")
+    p.add_argument("file")
+    p.set_defaults(func=cmd_check)
+    p = sub.add_parser("plugins", help="list registered plugins")
+    p.set_defaults(func=cmd_plugins)
+    p = sub.add_parser("plot", help="PNG plots of a results folder")
+    p.add_argument("dir")
+    p.add_argument("-o", "--output", help="folder for the PNGs (default DIR/plots)")
+    p.set_defaults(func=cmd_plot)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

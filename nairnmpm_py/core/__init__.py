@@ -1,0 +1,1 @@
+"""The Numba MPM engine: particle and grid arrays, shape functions, time step."""

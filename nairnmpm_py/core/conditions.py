@@ -1,0 +1,75 @@
+"""Boundary conditions as flat tables the kernels can read.
+
+Each condition element of the input is one *record* (style, value, start time,
+frequency) with a name for the results columns; its members are grid nodes
+(velocity conditions) or particles (loads).  Internal units: mm/ms, N, ms.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+GRID_VELOCITY = "velocity"
+PARTICLE_LOAD = "load"
+
+
+@dataclass
+class ConditionRecord:
+    name: str
+    kind: str        # GRID_VELOCITY or PARTICLE_LOAD
+    direction: int   # 0 = x, 1 = y
+    style: int
+    value: float
+    t0: float = 0.0
+    ftime: float = 0.0
+    n_members: int = 0
+
+
+@dataclass
+class Conditions:
+    records: list[ConditionRecord] = field(default_factory=list)
+    grid_nodes: list = field(default_factory=list)
+    grid_dirs: list = field(default_factory=list)
+    grid_recs: list = field(default_factory=list)
+    part_ids: list = field(default_factory=list)
+    part_dirs: list = field(default_factory=list)
+    part_scales: list = field(default_factory=list)
+    part_recs: list = field(default_factory=list)
+
+    def add_grid_velocity(self, record: ConditionRecord, nodes: np.ndarray) -> None:
+        r = len(self.records)
+        record.n_members = len(nodes)
+        self.records.append(record)
+        self.grid_nodes += [int(k) for k in nodes]
+        self.grid_dirs += [record.direction] * len(nodes)
+        self.grid_recs += [r] * len(nodes)
+
+    def add_particle_load(self, record: ConditionRecord, particles: np.ndarray,
+                          scales: np.ndarray) -> None:
+        r = len(self.records)
+        record.n_members = len(particles)
+        self.records.append(record)
+        self.part_ids += [int(p) for p in particles]
+        self.part_dirs += [record.direction] * len(particles)
+        self.part_scales += [float(s) for s in scales]
+        self.part_recs += [r] * len(particles)
+
+    def renumber_particles(self, new_index_of_old: np.ndarray) -> None:
+        self.part_ids = [int(new_index_of_old[p]) for p in self.part_ids]
+
+    def arrays(self) -> dict:
+        """Everything the kernels need, as contiguous numpy arrays."""
+        def ints(v):
+            return np.array(v, dtype=np.int64)
+        recs = self.records
+        return dict(
+            gbc_node=ints(self.grid_nodes), gbc_dir=ints(self.grid_dirs),
+            gbc_rec=ints(self.grid_recs),
+            pbc_part=ints(self.part_ids), pbc_dir=ints(self.part_dirs),
+            pbc_scale=np.array(self.part_scales, dtype=float), pbc_rec=ints(self.part_recs),
+            rec_style=ints([r.style for r in recs]),
+            rec_value=np.array([r.value for r in recs], dtype=float),
+            rec_t0=np.array([r.t0 for r in recs], dtype=float),
+            rec_ftime=np.array([r.ftime for r in recs], dtype=float),
+        )

@@ -1,0 +1,78 @@
+"""Build the step kernels of one scene, with its materials' updates inlined.
+
+Numba caches a compiled function by its source file, and cannot cache a kernel that
+receives a jitted function as an argument.  So for each set of material update
+functions we write a copy of ``step_kernels.py`` into a cache folder, with the
+default material import replaced by a dispatcher over exactly those updates.  The
+copy is written once per (kernel source, materials) pair; later runs load it and its
+Numba cache, which makes warm starts fast.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+from pathlib import Path
+
+from . import step_kernels
+
+MARKER = "# KERNEL-MATERIALS"
+
+
+def cache_dir() -> Path:
+    root = os.environ.get("NAIRNMPM_PY_CACHE")
+    if root:
+        return Path(root)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "nairnmpm_py" / "kernels"
+
+
+def _dispatch_source(update_functions: list[str]) -> str:
+    """Source of ``material_update`` calling the update of material index m."""
+    unique = sorted(set(update_functions))
+    lines = ["from numba import njit as _njit_dispatch"]
+    alias = {}
+    for i, ref in enumerate(unique):
+        module, func = ref.split(":")
+        alias[ref] = f"_material_update_{i}"
+        lines.append(f"from {module} import {func} as {alias[ref]}")
+    lines += [
+        "",
+        "",
+        "@_njit_dispatch(cache=True, inline='always')",
+        "def material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress):",
+    ]
+    for m, ref in enumerate(update_functions):
+        keyword = "if" if m == 0 else "elif"
+        lines.append(f"    {keyword} m == {m}:")
+        lines.append(f"        {alias[ref]}(p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress)")
+    return "\n".join(lines) + "\n"
+
+
+def load_kernels(update_functions: list[str]):
+    """Return the kernel module for materials using these update functions, in order."""
+    template = Path(step_kernels.__file__).read_text()
+    lines = template.splitlines()
+    marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]
+    if len(marked) != 1:
+        raise RuntimeError("step_kernels.py must have exactly one material import marker")
+    dispatch = _dispatch_source(update_functions)
+    lines[marked[0]] = dispatch
+    source = "\n".join(lines) + "\n"
+    digest = hashlib.sha256(source.encode()).hexdigest()[:16]
+    name = f"nairnmpm_kernels_{digest}"
+    if name in sys.modules:
+        return sys.modules[name]
+    folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.py"
+    if not path.exists() or path.read_text() != source:
+        tmp = path.with_suffix(f".tmp{os.getpid()}")
+        tmp.write_text(source)
+        os.replace(tmp, path)  # atomic: parallel runs never see half a file
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module

@@ -1,0 +1,338 @@
+"""Input model -> Simulation: grid, particles, materials, boundary conditions.
+
+Conversions to the engine's units (mm, g, ms; so N, MPa and mJ) happen here:
+velocities mm/s -> mm/ms, densities g/cm^3 -> g/mm^3, damping 1/s -> 1/ms.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from .. import plugins
+from ..core.conditions import GRID_VELOCITY, PARTICLE_LOAD, ConditionRecord, Conditions
+from ..core.grid import Grid
+from ..core.particles import Particles
+from ..core.shape import LINEAR, UGIMP
+from ..core.simulation import GlobalQuantity, Simulation
+from .models import AxisModel, BodyModel, ConditionModel, InputModel, ShapeModel
+from .reader import read_input
+from .xmlread import Reader
+
+PER_S_TO_PER_MS = 1e-3
+MM_PER_S_TO_MM_PER_MS = 1e-3
+
+
+def load_simulation(path) -> Simulation:
+    """Read, validate and build the simulation an input file describes."""
+    return build_simulation(read_input(path))
+
+
+def build_simulation(model: InputModel) -> Simulation:
+    r = Reader(model.path)
+    grid = _grid(r, model)
+    r.check()
+    materials, names = [], []
+    for m in model.materials:
+        info = plugins.resolve("materials", m.plugin)
+        materials.append(info.cls(info.cls.Params(**m.params), label=m.name))
+        names.append(m.name)
+    particles = _particles(r, model, grid, materials, names)
+    r.check()
+    conditions = _conditions(r, model, grid, particles)
+    quantities = _global_quantities(r, model, names)
+    r.check()
+    h = model.mpm
+    return Simulation(
+        grid=grid, particles=particles, materials=materials, conditions=conditions,
+        plane_stress=model.analysis == 11, method=h.method,
+        post_extrapolate=h.post_extrapolate, leave_limit=h.leave_limit,
+        shape=UGIMP if h.shape == "uGIMP" else LINEAR, max_time=h.max_time_ms,
+        time_step=h.time_step_ms, cfl=h.cfl, archive_time=h.archive_time_ms,
+        global_archive_time=h.global_archive_time_ms,
+        damping=h.damping_per_s * PER_S_TO_PER_MS, global_quantities=quantities,
+        title=model.title, source={"path": model.path, "sha256": model.sha256, "text": model.text},
+        material_names=names)
+
+
+# ---- grid -----------------------------------------------------------------------
+def _axis(lo: float, hi: float, axis: AxisModel) -> tuple[float, int]:
+    """Cells along one axis; a cell size that does not divide the length extends the
+    upper limit by one cell, as NairnMPM does."""
+    if axis.cellsize is not None:
+        cs = axis.cellsize
+        n = int(math.floor((hi - lo) / cs + 1e-9))
+        if lo + n * cs < hi - 1e-9 * cs:
+            n += 1
+        return lo + n * cs, max(n, 1)
+    return hi, axis.n
+
+
+def _grid(r: Reader, model: InputModel) -> Grid:
+    gm = model.grid
+    xmax, nx = _axis(gm.xmin, gm.xmax, gm.horiz)
+    ymax, ny = _axis(gm.ymin, gm.ymax, gm.vert)
+    grid = Grid(gm.xmin, xmax, gm.ymin, ymax, nx, ny, thickness=gm.thickness)
+    for axis, am, lo, h in ((0, gm.horiz, gm.xmin, grid.dx), (1, gm.vert, gm.ymin, grid.dy)):
+        for side, v in (("min", am.symmin), ("max", am.symmax)):
+            if v is None:
+                continue
+            k = (v - lo) / h
+            n_cells = nx if axis == 0 else ny
+            if abs(k - round(k)) > 1e-3 or not 0 <= round(k) <= n_cells:
+                r.problem(_at(am.line), f"sym{side}={v} is not on a grid line inside the grid")
+                continue
+            grid.symmetry.append((axis, lo + round(k) * h, side))
+    return grid
+
+
+class _at:
+    def __init__(self, line):
+        self.sourceline = line
+
+
+# ---- particles ----------------------------------------------------------------------
+def _contains(shape: ShapeModel, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    if shape.kind == "Rect":
+        inside = (x >= shape.xmin) & (x <= shape.xmax) & (y >= shape.ymin) & (y <= shape.ymax)
+    elif shape.kind == "Oval":
+        a = 0.5 * (shape.xmax - shape.xmin)
+        b = 0.5 * (shape.ymax - shape.ymin)
+        xc = 0.5 * (shape.xmax + shape.xmin)
+        yc = 0.5 * (shape.ymax + shape.ymin)
+        inside = ((x - xc) / a) ** 2 + ((y - yc) / b) ** 2 <= 1.0
+    else:
+        inside = _in_polygon(np.array(shape.points), x, y)
+    for cut in shape.cutouts:
+        inside &= ~_contains(cut, x, y)
+    return inside
+
+
+def _in_polygon(pts: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Crossing-number test; points on an edge count as inside."""
+    inside = np.zeros(x.shape, dtype=bool)
+    on_edge = np.zeros(x.shape, dtype=bool)
+    n = len(pts)
+    for i in range(n):
+        x1, y1 = pts[i]
+        x2, y2 = pts[(i + 1) % n]
+        crosses = (y1 > y) != (y2 > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xint = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+        inside ^= crosses & (x < xint)
+        seg = np.hypot(x2 - x1, y2 - y1)
+        cross = (x2 - x1) * (y - y1) - (y2 - y1) * (x - x1)
+        dot = (x - x1) * (x2 - x1) + (y - y1) * (y2 - y1)
+        on_edge |= (np.abs(cross) <= 1e-9 * max(seg, 1e-300) * max(seg, 1.0)) & (dot >= 0) & (dot <= seg * seg)
+    return inside | on_edge
+
+
+def _bbox(shape: ShapeModel) -> tuple[float, float, float, float]:
+    if shape.kind == "Polygon":
+        p = np.array(shape.points)
+        return p[:, 0].min(), p[:, 0].max(), p[:, 1].min(), p[:, 1].max()
+    return shape.xmin, shape.xmax, shape.ymin, shape.ymax
+
+
+def _candidates(grid: Grid, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Cell-centred sub-cell points, n per side in every cell."""
+    sub = (np.arange(n) + 0.5) / n
+    xs = (grid.xmin + (np.arange(grid.nx)[:, None] + sub[None, :]) * grid.dx).ravel()
+    ys = (grid.ymin + (np.arange(grid.ny)[:, None] + sub[None, :]) * grid.dy).ravel()
+    X, Y = np.meshgrid(xs, ys)
+    return X.ravel(), Y.ravel()
+
+
+def _material_index(r: Reader, body: BodyModel, names: list[str]) -> int | None:
+    if body.matname is not None:
+        if body.matname not in names:
+            r.problem(_at(body.line), f"<Body> matname=\"{body.matname}\" names no <Material> "
+                                      f"(defined: {', '.join(names)})")
+            return None
+        return names.index(body.matname)
+    if body.mat is None:
+        return None
+    if not 1 <= body.mat <= len(names):
+        r.problem(_at(body.line), f"<Body> mat=\"{body.mat}\" but only {len(names)} material(s) defined")
+        return None
+    return body.mat - 1
+
+
+def _particles(r: Reader, model: InputModel, grid: Grid, materials, names) -> Particles:
+    h = model.mpm
+    filled: dict[int, np.ndarray] = {}
+    cand: dict[int, tuple] = {}
+    chunks = []
+    for body in model.bodies:
+        mi = None if body.hole else _material_index(r, body, names)
+        for s in body.shapes:
+            x0, x1, y0, y1 = _bbox(s)
+            if x0 < grid.xmin or x1 > grid.xmax or y0 < grid.ymin or y1 > grid.ymax:
+                r.problem(_at(s.line), f"<{s.kind}> ({x0:g} to {x1:g}, {y0:g} to {y1:g}) extends "
+                                       f"outside the grid ({grid.xmin:g} to {grid.xmax:g}, "
+                                       f"{grid.ymin:g} to {grid.ymax:g})")
+        ppc = body.points_per_cell or h.points_per_cell
+        n = int(round(math.sqrt(ppc)))
+        if n not in cand:
+            cand[n] = _candidates(grid, n)
+            filled[n] = np.zeros(cand[n][0].size, dtype=bool)
+        X, Y = cand[n]
+        mask = np.zeros(X.size, dtype=bool)
+        for s in body.shapes:
+            mask |= _contains(s, X, Y)
+        mask &= ~filled[n]
+        filled[n] |= mask
+        if body.hole or mi is None:
+            continue
+        if not mask.any():
+            r.problem(_at(body.line), "<Body> creates no particles (shapes empty, outside the "
+                                      "grid, or covered by earlier bodies)")
+            continue
+        thick = body.thick if body.thick is not None else grid.thickness
+        vol = grid.dx * grid.dy / (n * n) * thick
+        k = int(mask.sum())
+        chunks.append(dict(x=X[mask], y=Y[mask], vol=np.full(k, vol),
+                           mass=np.full(k, vol * materials[mi].rho),
+                           vx=np.full(k, body.vx * MM_PER_S_TO_MM_PER_MS),
+                           vy=np.full(k, body.vy * MM_PER_S_TO_MM_PER_MS),
+                           lp=np.full(k, 0.5 / n), mat=np.full(k, mi), thick=np.full(k, thick),
+                           n=np.full(k, n)))
+    if not chunks:
+        return None
+    cat = {key: np.concatenate([c[key] for c in chunks]) for key in chunks[0]}
+    pd = np.array([(model.materials[m].pdamping_per_s if model.materials[m].pdamping_per_s
+                    is not None else h.pdamping_per_s) for m in range(len(materials))])
+    n_hist = max(m.n_history for m in materials)
+    p = Particles.allocate(np.vstack([cat["x"], cat["y"]]), np.vstack([cat["vx"], cat["vy"]]),
+                           cat["mass"], cat["vol"], np.vstack([cat["lp"], cat["lp"]]),
+                           cat["mat"], n_hist, pd[cat["mat"]] * PER_S_TO_PER_MS)
+    p.thick = cat["thick"]
+    p.per_side = cat["n"]
+    for i, m in enumerate(materials):
+        sel = p.mat == i
+        if sel.any() and m.n_history:
+            p.hist[:m.n_history, sel] = m.initial_history(int(sel.sum()))
+    return p
+
+
+# ---- boundary conditions --------------------------------------------------------------
+_KEYWORD = re.compile(r"^(min|max)([+-]?)(\d*\.?\d*)$")
+
+
+def _coordinate(raw: str, lo: float, hi: float, cell: float) -> float:
+    """A coordinate: a number, or min/max of the grid shifted by cells (min-, max+2)."""
+    m = _KEYWORD.match(raw.strip())
+    if not m:
+        return float(raw)
+    base = lo if m.group(1) == "min" else hi
+    sign = {"+": 1.0, "-": -1.0, "": 1.0}[m.group(2)]
+    if m.group(3):
+        amount = float(m.group(3))
+    else:
+        amount = 1.0 if m.group(2) else 0.0
+    return base + sign * amount * cell
+
+
+def _select(r: Reader, cond: ConditionModel, grid: Grid, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    cell = min(grid.dx, grid.dy)
+    c = cond.coords
+    try:
+        if cond.shape == "BCLine":
+            x1 = _coordinate(c["x1"], grid.xmin, grid.xmax, cell)
+            y1 = _coordinate(c["y1"], grid.ymin, grid.ymax, cell)
+            x2 = _coordinate(c["x2"], grid.xmin, grid.xmax, cell)
+            y2 = _coordinate(c["y2"], grid.ymin, grid.ymax, cell)
+            tol_raw = c.get("tolerance")
+            if tol_raw is None:
+                tol = 0.1 * cell
+            elif tol_raw.startswith("*"):
+                tol = float(tol_raw[1:]) * cell
+            else:
+                tol = float(tol_raw)
+            dx, dy = x2 - x1, y2 - y1
+            length = math.hypot(dx, dy)
+            if length == 0:
+                return np.nonzero(np.hypot(x - x1, y - y1) <= tol)[0]
+            ux, uy = dx / length, dy / length
+            along = (x - x1) * ux + (y - y1) * uy
+            across = np.abs(-(x - x1) * uy + (y - y1) * ux)
+            return np.nonzero((across <= tol) & (along >= -1e-9 * length) & (along <= length * (1 + 1e-9)))[0]
+        if cond.shape == "BCPt":
+            px = _coordinate(c["x"], grid.xmin, grid.xmax, cell)
+            py = _coordinate(c["y"], grid.ymin, grid.ymax, cell)
+            return np.array([int(np.argmin(np.hypot(x - px, y - py)))])
+        x1 = _coordinate(c["xmin"], grid.xmin, grid.xmax, cell)
+        x2 = _coordinate(c["xmax"], grid.xmin, grid.xmax, cell)
+        y1 = _coordinate(c["ymin"], grid.ymin, grid.ymax, cell)
+        y2 = _coordinate(c["ymax"], grid.ymin, grid.ymax, cell)
+        x1, x2 = sorted((x1, x2))
+        y1, y2 = sorted((y1, y2))
+        return np.nonzero((x >= x1) & (x <= x2) & (y >= y1) & (y <= y2))[0]
+    except ValueError as exc:
+        r.problem(_at(cond.shape_line), f"<{cond.shape}> has a coordinate that is not a number "
+                                        f"or min/max keyword ({exc})")
+        return np.array([], dtype=np.int64)
+
+
+FACE_NORMALS = {1: (0.0, -1.0), 2: (1.0, 0.0), 3: (0.0, 1.0), 4: (-1.0, 0.0)}
+
+
+def _conditions(r: Reader, model: InputModel, grid: Grid, particles: Particles) -> Conditions:
+    conds = Conditions()
+    nx_all, ny_all = grid.node_coordinates()
+    for cond in model.conditions:
+        axis_name = "x" if cond.direction in (1,) else "y"
+        if cond.element == "DisBC":
+            members = _select(r, cond, grid, nx_all, ny_all)
+            if members.size == 0:
+                r.problem(_at(cond.shape_line), f"<{cond.shape}> selects no grid nodes")
+                continue
+            rec = ConditionRecord(f"bc{cond.line}_{axis_name}", GRID_VELOCITY, cond.direction - 1,
+                                  cond.style, cond.value * MM_PER_S_TO_MM_PER_MS, cond.time,
+                                  cond.ftime)
+            conds.add_grid_velocity(rec, members)
+            continue
+        members = _select(r, cond, grid, particles.pos[0], particles.pos[1])
+        if members.size == 0:
+            r.problem(_at(cond.shape_line), f"<{cond.shape}> selects no particles")
+            continue
+        if cond.element == "LoadBC":
+            scale = np.full(members.size, 1.0 / members.size if cond.net else 1.0)
+            direction = cond.direction - 1
+        else:  # TractionBC: stress times the particle's face area
+            nrm = FACE_NORMALS[cond.face]
+            vec = {1: (1.0, 0.0), 2: (0.0, 1.0), 11: nrm, 12: (-nrm[1], nrm[0])}[cond.direction]
+            direction = 0 if vec[0] != 0 else 1
+            sign = vec[direction]
+            per_side = particles.per_side[members]
+            edge = np.where(cond.face in (1, 3), grid.dx / per_side, grid.dy / per_side)
+            scale = sign * edge * particles.thick[members]
+            axis_name = "x" if direction == 0 else "y"
+        rec = ConditionRecord(f"bc{cond.line}_{axis_name}", PARTICLE_LOAD, direction,
+                              cond.style, cond.value, cond.time, cond.ftime)
+        conds.add_particle_load(rec, members, scale)
+    return conds
+
+
+def _global_quantities(r: Reader, model: InputModel, names: list[str]) -> list[GlobalQuantity]:
+    out = []
+    for ga in model.mpm.global_archives:
+        if ga.type not in ("velx", "vely", "dispx", "dispy"):
+            continue  # energies and work are always in global.csv
+        if ga.matname is not None:
+            if ga.matname not in names:
+                r.problem(_at(ga.line), f"<GlobalArchive> matname=\"{ga.matname}\" names no material")
+                continue
+            mi = names.index(ga.matname)
+        elif ga.mat:
+            if not 1 <= ga.mat <= len(names):
+                r.problem(_at(ga.line), f"<GlobalArchive> mat=\"{ga.mat}\" is not a material number")
+                continue
+            mi = ga.mat - 1
+        else:
+            mi = -1
+        unit = "mm_s" if ga.type.startswith("vel") else "mm"
+        label = "all" if mi < 0 else re.sub(r"\W+", "_", names[mi]).strip("_")
+        out.append(GlobalQuantity(ga.type, mi, f"{ga.type}_{unit}_{label}"))
+    return out

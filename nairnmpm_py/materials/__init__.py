@@ -1,0 +1,1 @@
+"""Built-in material plugins (registered through entry points like any other)."""
