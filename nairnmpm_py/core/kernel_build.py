@@ -15,6 +15,8 @@ import os
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from . import step_kernels
 
 MARKER = "# KERNEL-MATERIALS"
@@ -28,30 +30,43 @@ def cache_dir() -> Path:
     return Path(base) / "nairnmpm_py" / "kernels"
 
 
-def _dispatch_source(update_functions: list[str]) -> str:
-    """Source of ``material_update`` calling the update of material index m."""
-    unique = sorted(set(update_functions))
+def _dispatch_source(functions: list[str]) -> str:
+    """Source of ``material_update``: row ``par`` of the material table starts with
+    the index of its update function in ``functions``, then the material's own
+    parameters.  The source depends only on the set of functions, so scenes with the
+    same kinds of material share one compiled kernel."""
     lines = ["from numba import njit as _njit_dispatch"]
-    alias = {}
-    for i, ref in enumerate(unique):
+    for i, ref in enumerate(functions):
         module, func = ref.split(":")
-        alias[ref] = f"_material_update_{i}"
-        lines.append(f"from {module} import {func} as {alias[ref]}")
+        lines.append(f"from {module} import {func} as _material_update_{i}")
     lines += [
         "",
         "",
         "@_njit_dispatch(cache=True, inline='always')",
         "def material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress):",
+        "    kind = int(par[0])",
+        "    own = par[1:]",
     ]
-    for m, ref in enumerate(update_functions):
-        keyword = "if" if m == 0 else "elif"
-        lines.append(f"    {keyword} m == {m}:")
-        lines.append(f"        {alias[ref]}(p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress)")
+    for i in range(len(functions)):
+        keyword = "if" if i == 0 else "elif"
+        lines.append(f"    {keyword} kind == {i}:")
+        lines.append(f"        _material_update_{i}(p, dt, L00, L01, L10, L11, F, stress, hist, w, own, plane_stress)")
     return "\n".join(lines) + "\n"
 
 
+def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.ndarray]:
+    """(sorted unique update functions, table of [function index, parameters...])."""
+    functions = sorted({m.update_function for m in materials})
+    vectors = [m.param_vector(plane_stress) for m in materials]
+    table = np.zeros((len(materials), 1 + max(len(v) for v in vectors)))
+    for i, (m, v) in enumerate(zip(materials, vectors)):
+        table[i, 0] = functions.index(m.update_function)
+        table[i, 1:1 + len(v)] = v
+    return functions, table
+
+
 def load_kernels(update_functions: list[str]):
-    """Return the kernel module for materials using these update functions, in order."""
+    """Return the kernel module dispatching over these update functions (in order)."""
     template = Path(step_kernels.__file__).read_text()
     lines = template.splitlines()
     marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]

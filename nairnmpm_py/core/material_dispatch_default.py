@@ -9,4 +9,4 @@ from nairnmpm_py.materials.isotropic import update as _isotropic
 
 @njit(cache=True, inline="always")
 def material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress):
-    _isotropic(p, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress)
+    _isotropic(p, dt, L00, L01, L10, L11, F, stress, hist, w, par[1:], plane_stress)

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import SimulationUnstable
 from .conditions import GRID_VELOCITY, ConditionRecord, Conditions
 from .grid import Grid
-from .kernel_build import load_kernels
+from .kernel_build import load_kernels, material_table
 from .particles import Particles
 from .shape import LINEAR, UGIMP
 
@@ -148,13 +148,8 @@ class Simulation:
         new_index[order] = np.arange(order.size)
         self.conditions.renumber_particles(new_index)
         self._add_symmetry_planes()
-        refs = [m.update_function for m in self.materials]
-        self.kernels = load_kernels(refs)
-        nparam = max(len(m.param_vector(self.plane_stress)) for m in self.materials)
-        self.mat_params = np.zeros((len(self.materials), nparam))
-        for i, m in enumerate(self.materials):
-            v = m.param_vector(self.plane_stress)
-            self.mat_params[i, :len(v)] = v
+        functions, self.mat_params = material_table(self.materials, self.plane_stress)
+        self.kernels = load_kernels(functions)
         self.nch = max(1, numba.get_num_threads())
         nn = g.n_nodes
         self.g = np.zeros((5, nn))
