@@ -65,9 +65,14 @@ def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.n
     return functions, table
 
 
-def load_kernels(update_functions: list[str]):
-    """Return the kernel module dispatching over these update functions (in order)."""
+def load_kernels(update_functions: list[str], parallel: bool = True):
+    """Return the kernel module dispatching over these update functions (in order).
+
+    ``parallel=False`` gives a serial twin: for small scenes, thread start-up and
+    barriers cost more than they save (and much more when the cores are busy)."""
     template = Path(step_kernels.__file__).read_text()
+    if not parallel:
+        template = template.replace("parallel=True", "parallel=False")
     lines = template.splitlines()
     marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]
     if len(marked) != 1:

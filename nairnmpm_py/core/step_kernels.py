@@ -219,9 +219,11 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
 
 @njit(cache=True, parallel=True)
 def _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                       plane_stress, geom, kind, gv, gbuf, nch, dt_stress, scatter):
-    """Velocity gradient from grid velocities ``gv``, stress update over
-    ``dt_stress``, and (if ``scatter``) the internal forces to the grid."""
+                       plane_stress, geom, kind, gv, gbuf, nch, dt_pending, dt_stress,
+                       scatter):
+    """Velocity gradient from grid velocities ``gv``; stress updates over
+    ``dt_pending`` (the last update of the previous step, whose velocity gradient is
+    this one) and ``dt_stress``; and (if ``scatter``) internal forces to the grid."""
     n = pos.shape[1]
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
@@ -238,7 +240,7 @@ def _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
             eta = (pos[1, p] - geom[1]) * idy
             i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
             j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
-            if dt_stress > 0.0:
+            if dt_stress > 0.0 or dt_pending > 0.0:
                 L00 = 0.0
                 L01 = 0.0
                 L10 = 0.0
@@ -257,8 +259,12 @@ def _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
                         L01 += gv[0, k] * gy
                         L10 += gv[1, k] * gx
                         L11 += gv[1, k] * gy
-                _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
-                               mat_params, plane_stress)
+                if dt_pending > 0.0:
+                    _stress_update(p, dt_pending, L00, L01, L10, L11, F, stress, hist, w,
+                                   mat, mat_params, plane_stress)
+                if dt_stress > 0.0:
+                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w,
+                                   mat, mat_params, plane_stress)
             if not scatter:
                 continue
             # current volume (thickness changes with F22 in plane stress)
@@ -358,9 +364,12 @@ def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec
 @njit(cache=True, parallel=True)
 def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                            plane_stress, geom, kind, ga, gvn, dt, dt_stress, damping,
-                           pdamp, bounds, vmax, left, bad, nch):
+                           pdamp, bounds, vmax, left, bad, gbuf, nch):
     """FLIP velocity and position update with grid and particle damping; with
-    ``dt_stress > 0`` also the USL half of the stress update (the "-" variant)."""
+    ``dt_stress > 0`` also the USL half of the stress update (the "-" variant).
+    Each updated particle then extrapolates its mass and momentum into ``gbuf``:
+    that is the next step's first extrapolation (and NairnMPM's post-update
+    extrapolation for USL+/USAVG+), done while the particle is in registers."""
     n = pos.shape[1]
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
@@ -370,6 +379,10 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
         lo = c * n // nch
         hi = (c + 1) * n // nch
         bad[c, 0] = -1
+        buf = gbuf[c]
+        buf[GM] = 0.0
+        buf[GPX] = 0.0
+        buf[GPY] = 0.0
         for p in range(lo, hi):
             xi = (pos[0, p] - geom[0]) * idx
             eta = (pos[1, p] - geom[1]) * idy
@@ -429,6 +442,22 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
             if dt_stress > 0.0:
                 _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
                                mat_params, plane_stress)
+            xi = (x - geom[0]) * idx
+            eta = (y - geom[1]) * idy
+            i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
+            j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
+            m = mass[p]
+            mvx = m * nvx
+            mvy = m * nvy
+            for b in range(na):
+                sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
+                row = (j0 + b) * nnx + i0
+                for a in range(na):
+                    sw = sy * (sx0 if a == 0 else (sx1 if a == 1 else sx2))
+                    k = row + a
+                    buf[GM, k] += sw * m
+                    buf[GPX, k] += sw * mvx
+                    buf[GPY, k] += sw * mvy
             if bad[c, 0] < 0:
                 if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
                         and math.isfinite(y) and math.isfinite(stress[0, p])):
@@ -457,11 +486,13 @@ def advance(nsteps, t, dt, method, post_extrapolate, kind, plane_stress,
             sym_out, sym_in, sym_dir, bad, nch):
     """Run up to ``nsteps`` steps from time ``t`` (ms).
 
-    ``post_extrapolate`` selects NairnMPM's USL+/USAVG+ (re-extrapolate momenta from
-    the updated particles before the last stress update) over the "-" variant (use
-    the updated grid momenta).  Returns (steps done, status, offending particle).
-    ``rec_force`` holds each condition's force (N) on the last step; ``rec_work``
-    accumulates its work (mJ).
+    ``post_extrapolate`` selects NairnMPM's USL+/USAVG+ over the "-" variant.  In
+    "+" the last stress update of a step uses momenta extrapolated from the updated
+    particles, with the conditions at the new time: exactly the next step's first
+    grid.  So it is carried over and done in the next step's stress pass, with the
+    same velocity gradient, and only the chunk's last step does it on its own.
+    Returns (steps done, status, offending particle).  ``rec_force`` holds each
+    condition's force (N) on the last step; ``rec_work`` accumulates its work (mJ).
     """
     pload = np.zeros(pbc_part.size)
     pos_before = np.zeros(pbc_part.size)
@@ -474,47 +505,61 @@ def advance(nsteps, t, dt, method, post_extrapolate, kind, plane_stress,
     else:
         dt_first = 0.5 * dt
         dt_last = dt - dt_first
+    dt_pending = 0.0
+    dt_in_update = 0.0 if post_extrapolate else dt_last
+    _pass_mass_momentum(pos, vel, mass, lp, geom, kind, gbuf, nch)
+    _reduce(gbuf, g, GM, GPY + 1, nch)
+    _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+                         rec_ftime, sym_out, sym_in, sym_dir, t)
+    _grid_velocity(g, gv, mass_tol)
     for step in range(nsteps):
         rec_force[:] = 0.0
-        _pass_mass_momentum(pos, vel, mass, lp, geom, kind, gbuf, nch)
-        _reduce(gbuf, g, GM, GPY + 1, nch)
+        _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
+                           plane_stress, geom, kind, gv, gbuf, nch, dt_pending, dt_first,
+                           True)
         g[GFX] = 0.0
         g[GFY] = 0.0
         _scatter_loads(pos, lp, geom, kind, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                        rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
-        _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
-                             rec_ftime, sym_out, sym_in, sym_dir, t)
-        _grid_velocity(g, gv, mass_tol)
-        _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                           plane_stress, geom, kind, gv, gbuf, nch, dt_first, True)
         _add_forces(gbuf, g, nch)
         _grid_update(g, gv, ga, gvn, dt, mass_tol)
         _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
                                    rec_value, rec_t0, rec_ftime, rec_force, rec_work,
                                    sym_out, sym_in, sym_dir, t, dt, mass_tol)
         _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
-                               plane_stress, geom, kind, ga, gvn, dt,
-                               0.0 if post_extrapolate else dt_last, damping, pdamp,
-                               bounds, vmax, left, bad, nch)
+                               plane_stress, geom, kind, ga, gvn, dt, dt_in_update,
+                               damping, pdamp, bounds, vmax, left, bad, gbuf, nch)
         _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
         t += dt
-        if post_extrapolate and dt_last > 0.0:
-            _pass_mass_momentum(pos, vel, mass, lp, geom, kind, gbuf, nch)
-            _reduce(gbuf, g, GM, GPY + 1, nch)
-            _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
-                                 rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
-            _grid_velocity(g, gv, mass_tol)
-            _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                               plane_stress, geom, kind, gv, gbuf, nch, dt_last, False)
+        _reduce(gbuf, g, GM, GPY + 1, nch)
+        _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+                             rec_ftime, sym_out, sym_in, sym_dir, t)
+        _grid_velocity(g, gv, mass_tol)
+        dt_pending = dt_last if post_extrapolate else 0.0
         n_left = 0
+        stop = False
+        status = STATUS_OK
+        who = -1
         for c in range(nch):
             if bad[c, 0] >= 0:
-                return step + 1, bad[c, 1], bad[c, 0]
+                stop = True
+                status = bad[c, 1]
+                who = bad[c, 0]
+                break
             n_left += bad[c, 2]
-        if n_left >= leave_limit:
+        if not stop and n_left >= leave_limit:
             for c in range(nch):
                 if bad[c, 2] > 0:
-                    return step + 1, STATUS_LEFT_GRID, bad[c, 3]
+                    stop = True
+                    status = STATUS_LEFT_GRID
+                    who = bad[c, 3]
+        if stop or step == nsteps - 1:
+            if dt_pending > 0.0:
+                _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
+                                   plane_stress, geom, kind, gv, gbuf, nch, 0.0, dt_pending,
+                                   False)
+            if stop:
+                return step + 1, status, who
     return nsteps, STATUS_OK, -1

@@ -50,6 +50,7 @@ def build_simulation(model: InputModel) -> Simulation:
         post_extrapolate=h.post_extrapolate, leave_limit=h.leave_limit,
         shape=UGIMP if h.shape == "uGIMP" else LINEAR, max_time=h.max_time_ms,
         time_step=h.time_step_ms, cfl=h.cfl, archive_time=h.archive_time_ms,
+        archive_start=h.archive_start_ms,
         global_archive_time=h.global_archive_time_ms,
         damping=h.damping_per_s * PER_S_TO_PER_MS, global_quantities=quantities,
         title=model.title, source={"path": model.path, "sha256": model.sha256, "text": model.text},

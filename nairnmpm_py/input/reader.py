@@ -33,6 +33,7 @@ def read_input(path: str | Path) -> InputModel:
     parts = {"title": "", "analysis": 10, "mpm": None, "grid": None, "bodies": [],
              "materials": [], "conditions": []}
     mesh_seen = False
+    material_elements = 0
     for el in r.children(root):
         tag = el.tag
         if tag == "Header":
@@ -57,6 +58,7 @@ def read_input(path: str | Path) -> InputModel:
                 else:
                     r.unknown(c, "MaterialPoints")
         elif tag == "Material":
+            material_elements += 1
             m = _material(r, el)
             if m is not None:
                 parts["materials"].append(m)
@@ -73,7 +75,7 @@ def read_input(path: str | Path) -> InputModel:
         r.problem(root, "missing <Mesh><Grid .../></Mesh>")
     if not any(not b.hole for b in parts["bodies"]):
         r.problem(root, "no <MaterialPoints><Body> defines any particles")
-    if not parts["materials"]:
+    if not material_elements:
         r.problem(root, "no <Material> defined")
     r.check()
     return InputModel(path=str(path), text=text, sha256=sha, **parts)
