@@ -22,6 +22,15 @@ class GlobalArchiveModel(Model):
     matname: str | None = None
 
 
+class CracksHeaderModel(Model):
+    jcontour_type: int = 1
+    jcontour_size: int = 2
+    friction: float = 0.0        # 0 = frictionless (the only kind so far)
+    contact_position: float | None = None
+    propagate: list[tuple[int, int, int]] = []   # (criterion, direction, traction)
+    propagate_length: float = 0.5
+
+
 class MPMHeaderModel(Model):
     method: Literal[0, 2, 3] = 2
     post_extrapolate: bool = True
@@ -38,7 +47,7 @@ class MPMHeaderModel(Model):
     pdamping_per_s: float = 0.0
     points_per_cell: int = 4
     leave_limit: int = 0
-    cracks_present: bool = False
+    cracks: CracksHeaderModel | None = None
 
 
 class AxisModel(Model):
@@ -103,6 +112,21 @@ class ConditionModel(Model):
     shape_line: int | None = None
 
 
+class CrackPointModel(Model):
+    x: float
+    y: float
+    tip: int = -1                # >0 tip material (J, propagation), -1 plain end, -2 exterior
+    law: int | None = None       # traction law: 1-based material number
+    lawname: str | None = None
+
+
+class CrackModel(Model):
+    fixed: bool = False
+    tprop: int | None = None
+    tpropname: str | None = None
+    points: list[CrackPointModel] = []
+
+
 class InputModel(Model):
     path: str
     text: str = ""
@@ -114,3 +138,4 @@ class InputModel(Model):
     bodies: list[BodyModel]
     materials: list[MaterialModel]
     conditions: list[ConditionModel] = []
+    cracks: list[CrackModel] = []

@@ -7,8 +7,9 @@ from pydantic import ValidationError
 
 from .. import plugins
 from ..errors import PluginError
-from .models import (AxisModel, BodyModel, ConditionModel, GlobalArchiveModel, GridModel,
-                     InputModel, MaterialModel, MPMHeaderModel, ShapeModel)
+from .models import (AxisModel, BodyModel, ConditionModel, CrackModel, CrackPointModel,
+                     CracksHeaderModel, GlobalArchiveModel, GridModel, InputModel,
+                     MaterialModel, MPMHeaderModel, ShapeModel)
 from .xmlread import Reader, parse_file
 
 # time units NairnMPM reads on header times, as factors to ms (absent = seconds)
@@ -31,7 +32,7 @@ def read_input(path: str | Path) -> InputModel:
         r.check()
     r.attrs(root, {"version": int})
     parts = {"title": "", "analysis": 10, "mpm": None, "grid": None, "bodies": [],
-             "materials": [], "conditions": []}
+             "materials": [], "conditions": [], "cracks": []}
     mesh_seen = False
     material_elements = 0
     for el in r.children(root):
@@ -66,7 +67,9 @@ def read_input(path: str | Path) -> InputModel:
             r.attrs(el, {})
             _conditions(r, el, parts["conditions"])
         elif tag == "CrackList":
-            r.problem(el, "<CrackList>: explicit cracks are not supported yet")
+            crack = _crack_list(r, el)
+            if crack is not None:
+                parts["cracks"].append(crack)
         else:
             r.unknown(el, "JANFEAInput")
     if parts["mpm"] is None:
@@ -198,7 +201,7 @@ def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
             elif v is not None:
                 h["leave_limit"] = v
         elif tag == "Cracks":
-            r.problem(c, "<Cracks>: explicit cracks are not supported yet")
+            h["cracks"] = _cracks_header(r, c)
         else:
             r.unknown(c, "MPMHeader")
     try:
@@ -433,3 +436,94 @@ def _append_condition(r, c, a, value, face, net, shape_el, coords, out) -> None:
     out.append(ConditionModel(element=c.tag, direction=a["dir"], style=style, value=value,
                               time=t0, ftime=ftime, face=face, net=net, shape=shape_el.tag,
                               coords=coords, shape_line=shape_el.sourceline, line=c.sourceline))
+
+
+# ---- cracks -----------------------------------------------------------------------
+def _cracks_header(r: Reader, el) -> CracksHeaderModel:
+    r.attrs(el, {})
+    h: dict = {"line": el.sourceline, "propagate": []}
+    for c in r.children(el):
+        if c.tag == "JContour":
+            a = r.attrs(c, {"type": int, "size": int, "terms": int, "gridenergy": int})
+            if a.get("type", 1) != 1:
+                r.problem(c, "<JContour> type: only 1 (square contour around the tip) is supported")
+            if a.get("size", 2) < 1:
+                r.problem(c, "<JContour> size must be at least 1 cell")
+            if a.get("terms", 1) != 1 or a.get("gridenergy", 0) != 0:
+                r.problem(c, "<JContour> terms=2 and gridenergy=1 are not supported")
+            h["jcontour_type"] = a.get("type", 1)
+            h["jcontour_size"] = a.get("size", 2)
+        elif c.tag == "Friction":
+            r.attrs(c, {})
+            v = r.text(c, float)
+            if v is not None and v != 0:
+                r.problem(c, f"<Friction>{v:g}: only 0 (frictionless crack contact) is supported")
+            elif v is not None:
+                h["friction"] = v
+        elif c.tag == "ContactPosition":
+            r.attrs(c, {})
+            v = r.text(c, float)
+            if v is not None:
+                h["contact_position"] = v
+        elif c.tag == "Propagate":
+            a = r.attrs(c, {"criterion": int, "direction": int, "traction": int})
+            h["propagate"].append((a.get("criterion", 0), a.get("direction", 0),
+                                   a.get("traction", 0)))
+        elif c.tag == "PropagateLength":
+            r.attrs(c, {})
+            v = r.text(c, float)
+            if v is not None:
+                if v <= 0:
+                    r.problem(c, "<PropagateLength> must be > 0 (cells)")
+                else:
+                    h["propagate_length"] = v
+        else:
+            r.unknown(c, "Cracks")
+    return CracksHeaderModel(**h)
+
+
+def _crack_list(r: Reader, el) -> CrackModel | None:
+    a = r.attrs(el, {"type": str, "Tprop": int, "Tpropname": str, "friction": float})
+    if "friction" in a and a["friction"] != 0:
+        r.problem(el, "<CrackList> friction: only 0 (frictionless) is supported")
+    points: list[CrackPointModel] = []
+    for c in r.children(el):
+        if c.tag == "Line":
+            b = r.attrs(c, {"xmin": float, "ymin": float, "xmax": float, "ymax": float,
+                            "resolution": int, "start_tip": int, "end_tip": int, "mat": int,
+                            "matname": str}, required=("xmin", "ymin", "xmax", "ymax"))
+            if len([k for k in ("xmin", "ymin", "xmax", "ymax") if k in b]) < 4:
+                continue
+            n = max(1, b.get("resolution", 1))
+            start = _tip_code(b.get("start_tip", -1))
+            end = _tip_code(b.get("end_tip", -1))
+            for i in range(n + 1):
+                f = i / n
+                x = b["xmin"] + f * (b["xmax"] - b["xmin"])
+                y = b["ymin"] + f * (b["ymax"] - b["ymin"])
+                tip = start if i == 0 else (end if i == n else -1)
+                if i == 0 and points and abs(points[-1].x - x) < 1e-12 and abs(points[-1].y - y) < 1e-12:
+                    # a line continuing the previous one shares its first point
+                    points[-1] = points[-1].model_copy(update={"law": b.get("mat"), "lawname": b.get("matname")})
+                    continue
+                points.append(CrackPointModel(x=x, y=y, tip=tip, law=b.get("mat"),
+                                              lawname=b.get("matname"), line=c.sourceline))
+        elif c.tag == "pt":
+            b = r.attrs(c, {"x": float, "y": float, "tip": int, "mat": int, "matname": str},
+                        required=("x", "y"))
+            if "x" in b and "y" in b:
+                points.append(CrackPointModel(x=b["x"], y=b["y"], tip=_tip_code(b.get("tip", -1)),
+                                              law=b.get("mat"), lawname=b.get("matname"),
+                                              line=c.sourceline))
+        else:
+            r.unknown(c, "CrackList")
+    if len(points) < 2:
+        r.problem(el, "<CrackList> needs at least two points (a <Line> or two <pt>)")
+        return None
+    return CrackModel(fixed=a.get("type") == "fixed", tprop=a.get("Tprop"),
+                      tpropname=a.get("Tpropname"), points=points, line=el.sourceline)
+
+
+def _tip_code(v: int) -> int:
+    """NairnMPM's tip codes: >0 tip material, -2 exterior end, anything else -1."""
+    return v if v > 0 or v == -2 else -1
