@@ -15,6 +15,7 @@ from ..core.conditions import GRID_VELOCITY, PARTICLE_LOAD, ConditionRecord, Con
 from ..core.grid import Grid
 from ..core.particles import Particles
 from ..core.shape import LINEAR, UGIMP
+from ..cracks.geometry import polyline_problems
 from ..core.simulation import GlobalQuantity, Simulation
 from .models import AxisModel, BodyModel, ConditionModel, InputModel, ShapeModel
 from .reader import read_input
@@ -31,11 +32,9 @@ def load_simulation(path) -> Simulation:
 
 def build_simulation(model: InputModel) -> Simulation:
     r = Reader(model.path)
-    for crack in model.cracks:
-        r.problem(_at(crack.line), "<CrackList>: the engine does not run explicit cracks yet "
-                                   "(the input is read and checked)")
-    r.check()
     grid = _grid(r, model)
+    r.check()
+    _check_cracks(r, model, grid)
     r.check()
     materials, names = [], []
     for m in model.materials:
@@ -95,6 +94,18 @@ def _grid(r: Reader, model: InputModel) -> Grid:
 class _at:
     def __init__(self, line):
         self.sourceline = line
+
+
+# ---- cracks -------------------------------------------------------------------------
+def _check_cracks(r: Reader, model: InputModel, grid: Grid) -> None:
+    cell = min(grid.dx, grid.dy)
+    for crack in model.cracks:
+        pts = np.array([(p.x, p.y) for p in crack.points])
+        for msg in polyline_problems(pts, (grid.xmin, grid.xmax), (grid.ymin, grid.ymax), cell):
+            r.problem(_at(crack.line), f"<CrackList>: {msg}")
+        if not r.problems:
+            r.problem(_at(crack.line), "<CrackList>: the engine does not run explicit cracks "
+                                       "yet (the input is read and checked)")
 
 
 # ---- particles ----------------------------------------------------------------------

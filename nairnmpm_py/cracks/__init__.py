@@ -1,0 +1,1 @@
+"""Explicit cracks: geometry, multi-field nodes, contact, J integral, propagation."""
