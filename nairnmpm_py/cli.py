@@ -35,9 +35,10 @@ def _summary(sim) -> str:
         f"particles:  {p.n}",
         f"grid:       {g.nx} x {g.ny} cells of {g.dx:g} x {g.dy:g} mm "
         f"({g.xmin:g} to {g.xmax:g}, {g.ymin:g} to {g.ymax:g} mm), thickness {g.thickness:g} mm",
-        "materials:  " + "; ".join(f"{n} ({m.name}, {int((p.mat == i).sum())} particles, "
-                                   f"wave speed {m.wave_speed():.4g} m/s)"
-                                   for i, (n, m) in enumerate(zip(sim.material_names, sim.materials))),
+        "materials:  " + "; ".join(
+            f"{n} ({m.name}, {int((p.mat == i).sum())} particles, wave speed {m.wave_speed():.4g} m/s)"
+            if hasattr(m, "wave_speed") else f"{n} ({m.name} traction law)"
+            for i, (n, m) in enumerate(zip(sim.material_names, sim.materials))),
         "cracks:     none",
         f"time step:  {sim.dt:.6g} ms (CFL limit {sim.cfl_time_step():.6g} ms at factor {sim.cfl:g})",
         f"max time:   {sim.max_time:g} ms, about {sim.n_steps} steps",
@@ -167,6 +168,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("dir")
     p.add_argument("-o", "--output", help="folder for the PNGs (default DIR/plots)")
     p.set_defaults(func=cmd_plot)
+    from .analysis import rcurve_cli
+    rcurve_cli.add_parser(sub)
     return ap
 
 

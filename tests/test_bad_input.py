@@ -60,7 +60,7 @@ CASES = {
                           r'matname="steel" names no <Material>'),
     "unknown-time-units": ('<MaxTime units="ms">', '<MaxTime units="fortnights">',
                            'units="fortnights"', r'units="fortnights" is not a known time unit'),
-    "unknown-material-type": ('Type="1"', 'Type="99"', 'Type="99"', r"no material plugin"),
+    "unknown-material-type": ('Type="1"', 'Type="99"', 'Type="99"', r"no material or traction-law plugin"),
 }
 
 PROBLEM_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<msg>.+)$")

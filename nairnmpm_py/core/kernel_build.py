@@ -55,13 +55,18 @@ def _dispatch_source(functions: list[str]) -> str:
 
 
 def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.ndarray]:
-    """(sorted unique update functions, table of [function index, parameters...])."""
-    functions = sorted({m.update_function for m in materials})
-    vectors = [m.param_vector(plane_stress) for m in materials]
+    """(sorted unique update functions, table of [function index, parameters...]).
+
+    Slots that are not solid materials (traction laws share NairnMPM's numbering)
+    get a zero row; no particle refers to them."""
+    solid = [m for m in materials if getattr(m, "update_function", "")]
+    functions = sorted({m.update_function for m in solid})
+    vectors = [m.param_vector(plane_stress) if m in solid else np.zeros(0) for m in materials]
     table = np.zeros((len(materials), 1 + max(len(v) for v in vectors)))
     for i, (m, v) in enumerate(zip(materials, vectors)):
-        table[i, 0] = functions.index(m.update_function)
-        table[i, 1:1 + len(v)] = v
+        if m in solid:
+            table[i, 0] = functions.index(m.update_function)
+            table[i, 1:1 + len(v)] = v
     return functions, table
 
 

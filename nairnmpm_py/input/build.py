@@ -38,8 +38,11 @@ def build_simulation(model: InputModel) -> Simulation:
     r.check()
     materials, names = [], []
     for m in model.materials:
-        info = plugins.resolve("materials", m.plugin)
-        materials.append(info.cls(info.cls.Params(**m.params), label=m.name))
+        info = plugins.resolve(m.group, m.plugin)
+        if m.group == "materials":
+            materials.append(info.cls(info.cls.Params(**m.params), label=m.name))
+        else:  # traction laws live on cracks; their slot keeps NairnMPM's numbering
+            materials.append(info.cls(info.cls.Params(**m.params)))
         names.append(m.name)
     particles = _particles(r, model, grid, materials, names)
     r.check()
@@ -160,19 +163,25 @@ def _candidates(grid: Grid, n: int) -> tuple[np.ndarray, np.ndarray]:
     return X.ravel(), Y.ravel()
 
 
-def _material_index(r: Reader, body: BodyModel, names: list[str]) -> int | None:
+def _material_index(r: Reader, body: BodyModel, names: list[str], model: InputModel) -> int | None:
     if body.matname is not None:
         if body.matname not in names:
             r.problem(_at(body.line), f"<Body> matname=\"{body.matname}\" names no <Material> "
                                       f"(defined: {', '.join(names)})")
             return None
-        return names.index(body.matname)
-    if body.mat is None:
+        index = names.index(body.matname)
+    elif body.mat is None:
         return None
-    if not 1 <= body.mat <= len(names):
+    elif not 1 <= body.mat <= len(names):
         r.problem(_at(body.line), f"<Body> mat=\"{body.mat}\" but only {len(names)} material(s) defined")
         return None
-    return body.mat - 1
+    else:
+        index = body.mat - 1
+    if model.materials[index].group != "materials":
+        r.problem(_at(body.line), f"<Body> material '{names[index]}' is a traction law "
+                                  f"({model.materials[index].plugin}); bodies need a solid material")
+        return None
+    return index
 
 
 def _particles(r: Reader, model: InputModel, grid: Grid, materials, names) -> Particles:
@@ -181,7 +190,7 @@ def _particles(r: Reader, model: InputModel, grid: Grid, materials, names) -> Pa
     cand: dict[int, tuple] = {}
     chunks = []
     for body in model.bodies:
-        mi = None if body.hole else _material_index(r, body, names)
+        mi = None if body.hole else _material_index(r, body, names, model)
         for s in body.shapes:
             x0, x1, y0, y1 = _bbox(s)
             if x0 < grid.xmin or x1 > grid.xmax or y0 < grid.ymin or y1 > grid.ymax:
@@ -219,7 +228,7 @@ def _particles(r: Reader, model: InputModel, grid: Grid, materials, names) -> Pa
     cat = {key: np.concatenate([c[key] for c in chunks]) for key in chunks[0]}
     pd = np.array([(model.materials[m].pdamping_per_s if model.materials[m].pdamping_per_s
                     is not None else h.pdamping_per_s) for m in range(len(materials))])
-    n_hist = max(m.n_history for m in materials)
+    n_hist = max(getattr(m, "n_history", 0) for m in materials)
     p = Particles.allocate(np.vstack([cat["x"], cat["y"]]), np.vstack([cat["vx"], cat["vy"]]),
                            cat["mass"], cat["vol"], np.vstack([cat["lp"], cat["lp"]]),
                            cat["mat"], n_hist, pd[cat["mat"]] * PER_S_TO_PER_MS)
@@ -227,7 +236,7 @@ def _particles(r: Reader, model: InputModel, grid: Grid, materials, names) -> Pa
     p.per_side = cat["n"]
     for i, m in enumerate(materials):
         sel = p.mat == i
-        if sel.any() and m.n_history:
+        if sel.any() and getattr(m, "n_history", 0):
             p.hist[:m.n_history, sel] = m.initial_history(int(sel.sum()))
     return p
 

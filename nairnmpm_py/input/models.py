@@ -92,6 +92,7 @@ class BodyModel(Model):
 class MaterialModel(Model):
     type: int | None = None
     plugin: str
+    group: Literal["materials", "traction_laws"] = "materials"
     name: str
     params: dict
     pdamping_per_s: float | None = None

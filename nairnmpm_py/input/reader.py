@@ -317,15 +317,21 @@ def _material(r: Reader, el) -> MaterialModel | None:
     a = r.attrs(el, {"Type": str, "Name": str}, required=("Type", "Name"))
     if "Type" not in a:
         return None
+    # NairnMPM numbers materials and traction laws in one list of <Material>s
+    info, group = None, None
     try:
-        info = plugins.resolve("materials", a["Type"])
+        for group in ("materials", "traction_laws"):
+            info = plugins.resolve(group, a["Type"])
+            if info is not None:
+                break
     except PluginError as exc:
         r.problem(el, str(exc))
         return None
     if info is None:
-        known = ", ".join(f"{p.name} ({p.nairn_type})" for p in plugins.registry("materials"))
-        r.problem(el, f"<Material Type=\"{a['Type']}\">: no material plugin of that type or "
-                      f"name (installed: {known})")
+        known = ", ".join(f"{p.name} ({p.nairn_type})" if p.nairn_type is not None else p.name
+                          for g in ("materials", "traction_laws") for p in plugins.registry(g))
+        r.problem(el, f"<Material Type=\"{a['Type']}\">: no material or traction-law plugin of "
+                      f"that type or name (installed: {known})")
         return None
     values, lines, pdamp = {}, {}, None
     fields = info.cls.Params.model_fields
@@ -359,7 +365,7 @@ def _material(r: Reader, el) -> MaterialModel | None:
                 msg = f"material '{a.get('Name')}' <{field}>: {msg}" if field else msg
             r.problem(_Line(where) if where else el, msg)
         return None
-    return MaterialModel(type=info.nairn_type, plugin=info.name, name=a.get("Name", ""),
+    return MaterialModel(type=info.nairn_type, plugin=info.name, group=group, name=a.get("Name", ""),
                          params=params.model_dump(), pdamping_per_s=pdamp, line=el.sourceline)
 
 

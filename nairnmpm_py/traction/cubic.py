@@ -1,0 +1,75 @@
+"""Cubic traction law (NairnMPM Type 14; seed paper Eq 20, Fig 2D).
+
+S(delta) = (27 sigma / 4) x (1 - x)^2 with x = delta/delta_c: peak sigma at
+delta_c/3, zero slope at delta_c, area J = 9 sigma delta_c / 16.
+
+Parameters per mode, as NairnMPM names them: two of ``sigmaI`` (MPa), ``delIc`` (mm),
+``JIc`` (J/m^2); mode II alike (``sigmaII``, ``delIIc``, ``JIIc``), or none of them for
+no shear traction.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from pydantic import model_validator
+
+from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, two_of_three
+
+AREA_FACTOR = 9.0 / 16.0
+
+
+class CubicParams(TractionParams):
+    sigmaI: float | None = None   # MPa
+    delIc: float | None = None    # mm
+    JIc: float | None = None      # J/m^2
+    sigmaII: float | None = None
+    delIIc: float | None = None
+    JIIc: float | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        resolve(self, 1)
+        resolve(self, 2)
+        return self
+
+
+def resolve(p: CubicParams, mode: int) -> tuple[float, float, float] | None:
+    """(sigma MPa, delta_c mm, J J/m^2) of one mode, or None for an absent mode II."""
+    m = MODE_NAMES[mode]
+    return two_of_three(p, (f"sigma{m}", f"del{m}c", f"J{m}c"), AREA_FACTOR,
+                        required=(mode == 1))
+
+
+class Cubic(TractionLaw):
+    name = "Cubic"
+    nairn_type = 14
+    Params = CubicParams
+    envelope_function = "nairnmpm_py.traction.cubic:envelope"
+
+    def mode_spec(self, mode):
+        r = resolve(self.params, mode)
+        if r is None:
+            return None
+        sigma, delta_c, J = r
+        return ModeSpec(delta_c=delta_c, par=np.array([delta_c, sigma]),
+                        peak_stress=sigma, peak_delta=delta_c / 3.0, area=J)
+
+    def envelope_array(self, delta, par):
+        x = delta / par[0]
+        return 6.75 * par[1] * x * (1.0 - x) ** 2
+
+    def area_to(self, delta, mode=1):
+        """Closed-form W_B(delta) = J x^2 (6 - 8x + 3x^2) in J/m^2."""
+        env = self.mode(mode)
+        x = np.clip(np.asarray(delta, dtype=float) / env.delta_c, 0.0, 1.0)
+        out = env.area * x * x * (6.0 - 8.0 * x + 3.0 * x * x)
+        return out if out.ndim else float(out)
+
+
+@njit(cache=True)
+def envelope(delta, par):
+    dc = par[0]
+    if delta < 0.0 or delta >= dc:
+        return 0.0
+    x = delta / dc
+    return 6.75 * par[1] * x * (1.0 - x) * (1.0 - x)

@@ -1,0 +1,73 @@
+"""Linear softening traction law (seed paper Fig 2E; no NairnMPM type).
+
+S(delta) = sigma (1 - delta/delta_c): the peak sigma is at delta = 0 (infinite initial
+stiffness), area J = sigma delta_c / 2.  NairnMPM has no such law: its Type 13
+(LinearTraction) is a linear *elastic* traction kIe*delta that never fails, and its
+triangular and trilinear laws refuse a zero-width elastic regime.  The law matters for
+the theory (Eq 27: Lindhagen and Berglund's R_eff); an engine using it should note the
+secant stiffness S(h)/h is unbounded as h -> 0.
+
+Parameters: two of ``sigmaI`` (MPa), ``delIc`` (mm), ``JIc`` (J/m^2); mode II alike
+or absent.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from pydantic import model_validator
+
+from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, two_of_three
+
+
+class LinearSofteningParams(TractionParams):
+    sigmaI: float | None = None   # MPa
+    delIc: float | None = None    # mm
+    JIc: float | None = None      # J/m^2
+    sigmaII: float | None = None
+    delIIc: float | None = None
+    JIIc: float | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        resolve(self, 1)
+        resolve(self, 2)
+        return self
+
+
+def resolve(p: LinearSofteningParams, mode: int) -> tuple[float, float, float] | None:
+    """(sigma MPa, delta_c mm, J J/m^2) of one mode, or None for an absent mode II."""
+    m = MODE_NAMES[mode]
+    return two_of_three(p, (f"sigma{m}", f"del{m}c", f"J{m}c"), 0.5, required=(mode == 1))
+
+
+class LinearSoftening(TractionLaw):
+    name = "LinearSoftening"
+    nairn_type = None
+    Params = LinearSofteningParams
+    envelope_function = "nairnmpm_py.traction.linear_softening:envelope"
+
+    def mode_spec(self, mode):
+        r = resolve(self.params, mode)
+        if r is None:
+            return None
+        sigma, delta_c, J = r
+        return ModeSpec(delta_c=delta_c, par=np.array([delta_c, sigma]),
+                        peak_stress=sigma, peak_delta=0.0, area=J)
+
+    def envelope_array(self, delta, par):
+        return par[1] * (1.0 - delta / par[0])
+
+    def area_to(self, delta, mode=1):
+        """Closed-form W_B(delta) = J x (2 - x) in J/m^2, x = delta/delta_c."""
+        env = self.mode(mode)
+        x = np.clip(np.asarray(delta, dtype=float) / env.delta_c, 0.0, 1.0)
+        out = env.area * x * (2.0 - x)
+        return out if out.ndim else float(out)
+
+
+@njit(cache=True)
+def envelope(delta, par):
+    dc = par[0]
+    if delta < 0.0 or delta >= dc:
+        return 0.0
+    return par[1] * (1.0 - delta / dc)
