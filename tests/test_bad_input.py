@@ -61,6 +61,12 @@ CASES = {
     "unknown-time-units": ('<MaxTime units="ms">', '<MaxTime units="fortnights">',
                            'units="fortnights"', r'units="fortnights" is not a known time unit'),
     "unknown-material-type": ('Type="1"', 'Type="99"', 'Type="99"', r"no material or traction-law plugin"),
+    "body-of-traction-law": ('<Material Type="1" Name="bar">\n    <rho>1</rho>\n    <E>1000</E>\n    <nu>0.3</nu>',
+                             '<Material Type="14" Name="bar">\n    <sigmaI>1</sigmaI>\n    <JIc>100</JIc>',
+                             '<Body mat="1"', r"is a traction law \(Cubic\)"),
+    "traction-law-three-parameters": ('<Material Type="1" Name="bar">\n    <rho>1</rho>\n    <E>1000</E>\n    <nu>0.3</nu>',
+                                      '<Material Type="1" Name="bar">\n    <rho>1</rho>\n    <E>1000</E>\n    <nu>0.3</nu>\n  </Material>\n  <Material Type="14" Name="law">\n    <sigmaI>1</sigmaI>\n    <delIc>0.2</delIc>\n    <JIc>112.5</JIc>',
+                                      '<Material Type="14"', r"give two of"),
 }
 
 PROBLEM_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<msg>.+)$")
