@@ -20,6 +20,7 @@ import numpy as np
 from . import step_kernels
 
 MARKER = "# KERNEL-MATERIALS"
+SHAPE_MARKER = "# KERNEL-SHAPE"
 
 
 def cache_dir() -> Path:
@@ -70,20 +71,18 @@ def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.n
     return functions, table
 
 
-def load_kernels(update_functions: list[str], parallel: bool = True):
-    """Return the kernel module dispatching over these update functions (in order).
-
-    ``parallel=False`` gives a serial twin: for small scenes, thread start-up and
-    barriers cost more than they save (and much more when the cores are busy)."""
+def load_kernels(update_functions: list[str], shape: int = 1):
+    """Return the kernel module dispatching over these update functions (in order),
+    compiled for one kind of shape function (0 linear, 1 uGIMP)."""
     template = Path(step_kernels.__file__).read_text()
-    if not parallel:
-        template = template.replace("parallel=True", "parallel=False")
     lines = template.splitlines()
     marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]
-    if len(marked) != 1:
-        raise RuntimeError("step_kernels.py must have exactly one material import marker")
-    dispatch = _dispatch_source(update_functions)
-    lines[marked[0]] = dispatch
+    shaped = [i for i, line in enumerate(lines) if SHAPE_MARKER in line]
+    if len(marked) != 1 or len(shaped) != 1:
+        raise RuntimeError("step_kernels.py must have exactly one material import marker "
+                           "and one shape marker")
+    lines[marked[0]] = _dispatch_source(update_functions)
+    lines[shaped[0]] = f"KIND = {int(shape)}  # shape functions of this build"
     source = "\n".join(lines) + "\n"
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
     name = f"nairnmpm_kernels_{digest}"

@@ -157,7 +157,7 @@ class Simulation:
         threads = numba.get_num_threads()
         if self.parallel is None:
             self.parallel = threads > 1 and p.n >= PARALLEL_MIN_PARTICLES
-        self.kernels = load_kernels(functions, parallel=self.parallel and threads > 1)
+        self.kernels = load_kernels(functions, self.shape)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
         self.g = np.zeros((5, nn))
@@ -230,17 +230,22 @@ class Simulation:
         self.prepare()
         p = self.particles
         c = self.cond_arrays
-        done, status, bad = self.kernels.advance(
-            nsteps, self.time, self.dt, self.method, self.post_extrapolate, self.shape,
-            self.plane_stress,
-            p.pos, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress, p.hist, p.w,
-            p.pdamp, self.mat_params, self.geom, self.bounds, self.g, self.gbuf, self.gv,
-            self.ga, self.gvn, self.gtmp, self.damping, self.mass_tol, self.vmax, self.left,
-            self.leave_max,
-            c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-            c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
-            c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
-            self.sym_dir, self.bad, self.nch)
+        threads = numba.get_num_threads()
+        if not self.parallel:
+            numba.set_num_threads(1)  # one chunk: no thread pool, no barriers
+        try:
+            done, status, bad = self.kernels.advance(
+                nsteps, self.time, self.dt, self.method, self.post_extrapolate,
+                self.plane_stress, p.pos, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F,
+                p.stress, p.hist, p.w, p.pdamp, self.mat_params, self.geom, self.bounds,
+                self.g, self.gbuf, self.gv, self.ga, self.gvn, self.gtmp, self.damping,
+                self.mass_tol, self.vmax, self.left, self.leave_max,
+                c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
+                c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
+                c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
+                self.sym_dir, self.bad, self.nch)
+        finally:
+            numba.set_num_threads(threads)
         self.step += int(done)
         self.time += int(done) * self.dt
         if status != 0:

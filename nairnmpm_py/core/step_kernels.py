@@ -2,25 +2,26 @@
 
 This file is a template as well as a module: ``kernel_build`` copies it into a cache
 folder with the ``material_update`` import replaced by a dispatcher over the
-materials of one scene, so the stress update of any material plugin is inlined in the
-particle loops and everything stays ``cache=True``.  Imported directly it dispatches
-to the isotropic material only (used by tests of the kernels themselves).
+materials of one scene and ``KIND`` set to its shape functions, so the stress update
+of any material plugin is inlined in the particle loops, the shape function is known
+at compile time, and everything stays ``cache=True``.  Imported directly it runs
+uGIMP with the isotropic material only.
 
 One step (``advance`` runs many without returning to Python):
 
-1. particles -> grid: mass and momentum (pass A), then particle loads;
-2. grid velocity conditions on momentum;
-3. USF / USAVG: velocity gradient from the grid, stress update (dt or dt/2), and the
-   internal forces back to the grid (pass B, fused);
-4. momentum update, velocity conditions on the new momentum (reactions recorded);
-5. grid -> particles: velocity (FLIP) and position with grid and particle damping
-   (as NairnMPM applies them), and for USL- / USAVG- the stress update from the
-   updated grid velocities (pass C, fused);
-6. for USL+ / USAVG+ (NairnMPM's default): momenta extrapolated again from the
-   updated particles and the last stress update from those.
+1. particle loads onto the grid; stress update from the grid velocities (USF /
+   USAVG first half, plus a carried-over USAVG+ / USL+ last half) fused with the
+   internal forces back to the grid;
+2. forces summed, momenta updated, velocity conditions on the new momenta
+   (reactions recorded);
+3. grid -> particles: FLIP velocity and position with grid and particle damping (as
+   NairnMPM applies them), the USL- / USAVG- stress update, then the particle's new
+   weights and its mass and momentum back to the grid for the next step;
+4. mass and momentum summed, velocity conditions at the new time.
 
 Particle loops run as fixed chunks, each with its own grid buffer, reduced in a fixed
-order: results do not depend on thread scheduling.
+order: results do not depend on thread scheduling.  ``FAST`` allows reassociation and
+fused multiply-adds but keeps NaN and infinity semantics, so blow-ups are still caught.
 """
 from __future__ import annotations
 
@@ -31,6 +32,10 @@ from numba import njit, prange
 
 from nairnmpm_py.core.shape import weights_1d
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
+
+KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
+NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
+FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
 
 USF = 0
 USAVG = 2
@@ -72,52 +77,12 @@ def bc_value(style, value, t0, ftime, t):
     return 0.0
 
 
-@njit(cache=True, parallel=True)
-def _pass_mass_momentum(pos, vel, mass, lp, geom, kind, gbuf, nch):
-    n = pos.shape[1]
-    nnx = int(geom[4])
-    na = 2 if kind == 0 else 3
-    for c in prange(nch):
-        buf = gbuf[c]
-        buf[:] = 0.0
-        lo = c * n // nch
-        hi = (c + 1) * n // nch
-        for p in range(lo, hi):
-            xi = (pos[0, p] - geom[0]) / geom[2]
-            eta = (pos[1, p] - geom[1]) / geom[3]
-            i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
-            j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
-            m = mass[p]
-            mvx = m * vel[0, p]
-            mvy = m * vel[1, p]
-            for b in range(na):
-                sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-                row = (j0 + b) * nnx + i0
-                for a in range(na):
-                    s = sy * (sx0 if a == 0 else (sx1 if a == 1 else sx2))
-                    k = row + a
-                    buf[GM, k] += s * m
-                    buf[GPX, k] += s * mvx
-                    buf[GPY, k] += s * mvy
-
-
-@njit(cache=True, parallel=True)
-def _reduce(gbuf, g, first, last, nch):
-    nn = g.shape[1]
-    for k in prange(nn):
-        for r in range(first, last):
-            acc = 0.0
-            for c in range(nch):
-                acc += gbuf[c, r, k]
-            g[r, k] = acc
-
-
-@njit(cache=True)
-def _scatter_loads(pos, lp, geom, kind, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+@njit(cache=True, error_model="numpy")
+def _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                    rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
     """Particle loads (N) at time t onto the grid; pload keeps them for the work."""
     nnx = int(geom[4])
-    na = 2 if kind == 0 else 3
+    na = NA
     for q in range(pbc_part.size):
         r = pbc_rec[q]
         f = pbc_scale[q] * bc_value(rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
@@ -127,8 +92,8 @@ def _scatter_loads(pos, lp, geom, kind, g, pbc_part, pbc_dir, pbc_scale, pbc_rec
         row_c = GFX + pbc_dir[q]
         xi = (pos[0, p] - geom[0]) / geom[2]
         eta = (pos[1, p] - geom[1]) / geom[3]
-        i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
-        j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
+        i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, KIND, lp[0, p])
+        j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, KIND, lp[1, p])
         for b in range(na):
             sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
             row = (j0 + b) * nnx + i0
@@ -137,7 +102,7 @@ def _scatter_loads(pos, lp, geom, kind, g, pbc_part, pbc_dir, pbc_scale, pbc_rec
                 g[row_c, row + a] += s * f
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                          rec_ftime, sym_out, sym_in, sym_dir, t):
     """Impose velocity conditions on the extrapolated momenta.
@@ -165,19 +130,6 @@ def _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, re
             g[GPX + d, ko] = 0.0
 
 
-@njit(cache=True, parallel=True)
-def _grid_velocity(g, gv, mass_tol):
-    nn = g.shape[1]
-    for k in prange(nn):
-        m = g[GM, k]
-        if m > mass_tol:
-            gv[0, k] = g[GPX, k] / m
-            gv[1, k] = g[GPY, k] / m
-        else:
-            gv[0, k] = 0.0
-            gv[1, k] = 0.0
-
-
 @njit(cache=True, inline="always")
 def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
                    plane_stress):
@@ -188,18 +140,24 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
     d = L11 * dt
     half = 0.5 * (a + d)
     disc = 0.25 * (a - d) * (a - d) + b * c
-    if disc > 1e-14:
+    # cosh(sqrt(disc)) and sinh(sqrt(disc))/sqrt(disc) (cos, sin for disc < 0) as their
+    # series in disc: exact to rounding for |disc| < 1e-4 (next term < 1e-20), which is
+    # every step of a stable explicit run; the libm calls only for large increments
+    if abs(disc) < 1e-4:
+        ch = 1.0 + disc * (0.5 + disc * (1.0 / 24.0 + disc * (1.0 / 720.0)))
+        sh = 1.0 + disc * (1.0 / 6.0 + disc * (1.0 / 120.0 + disc * (1.0 / 5040.0)))
+    elif disc > 0.0:
         q = math.sqrt(disc)
         ch = math.cosh(q)
         sh = math.sinh(q) / q
-    elif disc < -1e-14:
+    else:
         q = math.sqrt(-disc)
         ch = math.cos(q)
         sh = math.sin(q) / q
+    if abs(half) < 1e-3:
+        e = 1.0 + half * (1.0 + half * (0.5 + half * (1.0 / 6.0 + half * (1.0 / 24.0 + half * (1.0 / 120.0)))))
     else:
-        ch = 1.0 + 0.5 * disc
-        sh = 1.0 + disc / 6.0
-    e = math.exp(half)
+        e = math.exp(half)
     e00 = e * (ch + sh * (a - half))
     e01 = e * sh * b
     e10 = e * sh * c
@@ -217,109 +175,7 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
                     plane_stress)
 
 
-@njit(cache=True, parallel=True)
-def _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                       plane_stress, geom, kind, gv, gbuf, nch, dt_pending, dt_stress,
-                       scatter):
-    """Velocity gradient from grid velocities ``gv``; stress updates over
-    ``dt_pending`` (the last update of the previous step, whose velocity gradient is
-    this one) and ``dt_stress``; and (if ``scatter``) internal forces to the grid."""
-    n = pos.shape[1]
-    nnx = int(geom[4])
-    idx = 1.0 / geom[2]
-    idy = 1.0 / geom[3]
-    na = 2 if kind == 0 else 3
-    for c in prange(nch):
-        buf = gbuf[c]
-        buf[GFX] = 0.0
-        buf[GFY] = 0.0
-        lo = c * n // nch
-        hi = (c + 1) * n // nch
-        for p in range(lo, hi):
-            xi = (pos[0, p] - geom[0]) * idx
-            eta = (pos[1, p] - geom[1]) * idy
-            i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
-            j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
-            if dt_stress > 0.0 or dt_pending > 0.0:
-                L00 = 0.0
-                L01 = 0.0
-                L10 = 0.0
-                L11 = 0.0
-                for b in range(na):
-                    sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-                    dy = (dy0 if b == 0 else (dy1 if b == 1 else dy2)) * idy
-                    row = (j0 + b) * nnx + i0
-                    for a in range(na):
-                        sx = sx0 if a == 0 else (sx1 if a == 1 else sx2)
-                        dx = (dx0 if a == 0 else (dx1 if a == 1 else dx2)) * idx
-                        k = row + a
-                        gx = dx * sy
-                        gy = sx * dy
-                        L00 += gv[0, k] * gx
-                        L01 += gv[0, k] * gy
-                        L10 += gv[1, k] * gx
-                        L11 += gv[1, k] * gy
-                if dt_pending > 0.0:
-                    _stress_update(p, dt_pending, L00, L01, L10, L11, F, stress, hist, w,
-                                   mat, mat_params, plane_stress)
-                if dt_stress > 0.0:
-                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w,
-                                   mat, mat_params, plane_stress)
-            if not scatter:
-                continue
-            # current volume (thickness changes with F22 in plane stress)
-            vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
-            sxx = stress[0, p] * vol
-            syy = stress[1, p] * vol
-            sxy = stress[2, p] * vol
-            for b in range(na):
-                sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-                dy = (dy0 if b == 0 else (dy1 if b == 1 else dy2)) * idy
-                row = (j0 + b) * nnx + i0
-                for a in range(na):
-                    sx = sx0 if a == 0 else (sx1 if a == 1 else sx2)
-                    dx = (dx0 if a == 0 else (dx1 if a == 1 else dx2)) * idx
-                    k = row + a
-                    gx = dx * sy
-                    gy = sx * dy
-                    buf[GFX, k] -= sxx * gx + sxy * gy
-                    buf[GFY, k] -= sxy * gx + syy * gy
-
-
-@njit(cache=True, parallel=True)
-def _add_forces(gbuf, g, nch):
-    """Add the chunks' internal forces onto the loads already on the grid."""
-    nn = g.shape[1]
-    for k in prange(nn):
-        fx = 0.0
-        fy = 0.0
-        for c in range(nch):
-            fx += gbuf[c, GFX, k]
-            fy += gbuf[c, GFY, k]
-        g[GFX, k] += fx
-        g[GFY, k] += fy
-
-
-@njit(cache=True, parallel=True)
-def _grid_update(g, gv, ga, gvn, dt, mass_tol):
-    nn = g.shape[1]
-    for k in prange(nn):
-        m = g[GM, k]
-        if m > mass_tol:
-            fx = g[GFX, k]
-            fy = g[GFY, k]
-            ga[0, k] = fx / m
-            ga[1, k] = fy / m
-            gvn[0, k] = (g[GPX, k] + fx * dt) / m
-            gvn[1, k] = (g[GPY, k] + fy * dt) / m
-        else:
-            ga[0, k] = 0.0
-            ga[1, k] = 0.0
-            gvn[0, k] = 0.0
-            gvn[1, k] = 0.0
-
-
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
                                rec_value, rec_t0, rec_ftime, rec_force, rec_work,
                                sym_out, sym_in, sym_dir, t, dt, mass_tol):
@@ -361,33 +217,212 @@ def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec
             ga[d, ko] = (v_new - v_old) / dt
 
 
-@njit(cache=True, parallel=True)
-def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
-                           plane_stress, geom, kind, ga, gvn, dt, dt_stress, damping,
-                           pdamp, bounds, vmax, left, bad, gbuf, nch):
-    """FLIP velocity and position update with grid and particle damping; with
-    ``dt_stress > 0`` also the USL half of the stress update (the "-" variant).
-    Each updated particle then extrapolates its mass and momentum into ``gbuf``:
-    that is the next step's first extrapolation (and NairnMPM's post-update
-    extrapolation for USL+/USAVG+), done while the particle is in registers."""
+@njit(cache=True, error_model="numpy")
+def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
+    for q in range(pbc_part.size):
+        p = pbc_part[q]
+        d = pbc_dir[q]
+        rec_work[pbc_rec[q]] += pload[q] * (pos[d, p] - pos_before[q])
+
+
+
+# ---- cached weights ------------------------------------------------------------------
+# wc[p] = (sx0, sx1, sx2, sy0, sy1, sy2, gx0, gx1, gx2, gy0, gy1, gy2) with the
+# derivatives already divided by the cell size; wij[p] = (i0, j0)
+
+
+@njit(cache=True, inline="always")
+def _store_weights(p, pos, lp, geom, idx, idy, wij, wc):
+    xi = (pos[0, p] - geom[0]) * idx
+    eta = (pos[1, p] - geom[1]) * idy
+    i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, KIND, lp[0, p])
+    j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, KIND, lp[1, p])
+    wij[p, 0] = i0
+    wij[p, 1] = j0
+    r = wc[p]
+    r[0] = sx0
+    r[1] = sx1
+    r[2] = sx2
+    r[3] = sy0
+    r[4] = sy1
+    r[5] = sy2
+    r[6] = dx0 * idx
+    r[7] = dx1 * idx
+    r[8] = dx2 * idx
+    r[9] = dy0 * idy
+    r[10] = dy1 * idy
+    r[11] = dy2 * idy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def _weights_and_mass(pos, vel, mass, lp, geom, wij, wc, gbuf, nch):
+    """Weights of every particle (cached) and their mass and momentum on the grid."""
     n = pos.shape[1]
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
     idy = 1.0 / geom[3]
-    na = 2 if kind == 0 else 3
     for c in prange(nch):
+        buf = gbuf[c]
+        buf[:] = 0.0
         lo = c * n // nch
         hi = (c + 1) * n // nch
-        bad[c, 0] = -1
+        for p in range(lo, hi):
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            r = wc[p]
+            m = mass[p]
+            mvx = m * vel[0, p]
+            mvy = m * vel[1, p]
+            for b in range(NA):
+                sy = r[3 + b]
+                row = (wij[p, 1] + b) * nnx + wij[p, 0]
+                for a in range(NA):
+                    s = sy * r[a]
+                    k = row + a
+                    buf[GM, k] += s * m
+                    buf[GPX, k] += s * mvx
+                    buf[GPY, k] += s * mvy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def _reduce_velocity(gbuf, g, gv, mass_tol, nch):
+    """Sum the chunks' mass and momentum and the grid velocities (before conditions)."""
+    nn = g.shape[1]
+    for k in prange(nn):
+        m = 0.0
+        px = 0.0
+        py = 0.0
+        for c in range(nch):
+            m += gbuf[c, GM, k]
+            px += gbuf[c, GPX, k]
+            py += gbuf[c, GPY, k]
+        g[GM, k] = m
+        g[GPX, k] = px
+        g[GPY, k] = py
+        if m > mass_tol:
+            gv[0, k] = px / m
+            gv[1, k] = py / m
+        else:
+            gv[0, k] = 0.0
+            gv[1, k] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _velocity_at(g, gv, nodes, mass_tol):
+    for q in range(nodes.size):
+        k = nodes[q]
+        m = g[GM, k]
+        if m > mass_tol:
+            gv[0, k] = g[GPX, k] / m
+            gv[1, k] = g[GPY, k] / m
+        else:
+            gv[0, k] = 0.0
+            gv[1, k] = 0.0
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
+                         geom, wij, wc, gv, gbuf, nch, dt_pre, dt_stress, scatter, n):
+    nnx = int(geom[4])
+    for c in prange(nch):
+        buf = gbuf[c]
+        if scatter:
+            buf[GFX] = 0.0
+            buf[GFY] = 0.0
+        lo = c * n // nch
+        hi = (c + 1) * n // nch
+        for p in range(lo, hi):
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            if dt_stress > 0.0 or dt_pre > 0.0:
+                L00 = 0.0
+                L01 = 0.0
+                L10 = 0.0
+                L11 = 0.0
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        L00 += gv[0, k] * gx
+                        L01 += gv[0, k] * gy
+                        L10 += gv[1, k] * gx
+                        L11 += gv[1, k] * gy
+                if dt_pre > 0.0:
+                    _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
+                                   mat_params, plane_stress)
+                if dt_stress > 0.0:
+                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
+                                   mat_params, plane_stress)
+            if not scatter:
+                continue
+            vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
+            sxx = stress[0, p] * vol
+            syy = stress[1, p] * vol
+            sxy = stress[2, p] * vol
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    gx = r[6 + a] * sy
+                    gy = r[a] * dy
+                    buf[GFX, k] -= sxx * gx + sxy * gy
+                    buf[GFY, k] -= sxy * gx + syy * gy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def _forces_update(gbuf, g, ga, gvn, dt, mass_tol, nch):
+    nn = g.shape[1]
+    for k in prange(nn):
+        fx = 0.0
+        fy = 0.0
+        for c in range(nch):
+            fx += gbuf[c, GFX, k]
+            fy += gbuf[c, GFY, k]
+        fx = g[GFX, k] + fx
+        fy = g[GFY, k] + fy
+        g[GFX, k] = fx
+        g[GFY, k] = fy
+        m = g[GM, k]
+        if m > mass_tol:
+            ga[0, k] = fx / m
+            ga[1, k] = fy / m
+            gvn[0, k] = (g[GPX, k] + fx * dt) / m
+            gvn[1, k] = (g[GPY, k] + fy * dt) / m
+        else:
+            ga[0, k] = 0.0
+            ga[1, k] = 0.0
+            gvn[0, k] = 0.0
+            gvn[1, k] = 0.0
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def _update_and_extrapolate(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
+                            plane_stress, geom, ga, gvn, dt, dt_stress, damping,
+                            pdamp, bounds, vmax, left, bad, wij, wc, gbuf, nch):
+    """Grid -> particles (FLIP, positions), then the particles' new weights and their
+    mass and momentum back to the grid (the next extrapolation)."""
+    n = pos.shape[1]
+    nnx = int(geom[4])
+    idx = 1.0 / geom[2]
+    idy = 1.0 / geom[3]
+    for c in prange(nch):
         buf = gbuf[c]
         buf[GM] = 0.0
         buf[GPX] = 0.0
         buf[GPY] = 0.0
+        lo = c * n // nch
+        hi = (c + 1) * n // nch
+        bad[c, 0] = -1
         for p in range(lo, hi):
-            xi = (pos[0, p] - geom[0]) * idx
-            eta = (pos[1, p] - geom[1]) * idy
-            i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
-            j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
             ax = 0.0
             ay = 0.0
             vx = 0.0
@@ -396,28 +431,26 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
             L01 = 0.0
             L10 = 0.0
             L11 = 0.0
-            for b in range(na):
-                sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-                dy = (dy0 if b == 0 else (dy1 if b == 1 else dy2)) * idy
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
                 row = (j0 + b) * nnx + i0
-                for a in range(na):
-                    sx = sx0 if a == 0 else (sx1 if a == 1 else sx2)
-                    dx = (dx0 if a == 0 else (dx1 if a == 1 else dx2)) * idx
+                for a in range(NA):
                     k = row + a
-                    s = sx * sy
-                    gx = dx * sy
-                    gy = sx * dy
+                    s = r[a] * sy
                     ax += s * ga[0, k]
                     ay += s * ga[1, k]
                     vnx = gvn[0, k]
                     vny = gvn[1, k]
                     vx += s * vnx
                     vy += s * vny
-                    L00 += vnx * gx
-                    L01 += vnx * gy
-                    L10 += vny * gx
-                    L11 += vny * gy
-            # grid velocity at the particle before the update, then damped FLIP
+                    if dt_stress > 0.0:
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        L00 += vnx * gx
+                        L01 += vnx * gy
+                        L10 += vny * gx
+                        L11 += vny * gy
             vmx = vx - ax * dt
             vmy = vy - ay * dt
             dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
@@ -429,8 +462,6 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
             x = pos[0, p] + (vmx + 0.5 * dvx) * dt
             y = pos[1, p] + (vmy + 0.5 * dvy) * dt
             if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
-                # NairnMPM's LeaveLimit rule: push the particle back where it was and
-                # count it; the run stops once too many distinct particles have left
                 if left[p] == 0:
                     left[p] = 1
                     bad[c, 2] += 1
@@ -442,22 +473,6 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
             if dt_stress > 0.0:
                 _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
                                mat_params, plane_stress)
-            xi = (x - geom[0]) * idx
-            eta = (y - geom[1]) * idy
-            i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, kind, lp[0, p])
-            j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, kind, lp[1, p])
-            m = mass[p]
-            mvx = m * nvx
-            mvy = m * nvy
-            for b in range(na):
-                sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-                row = (j0 + b) * nnx + i0
-                for a in range(na):
-                    sw = sy * (sx0 if a == 0 else (sx1 if a == 1 else sx2))
-                    k = row + a
-                    buf[GM, k] += sw * m
-                    buf[GPX, k] += sw * mvx
-                    buf[GPY, k] += sw * mvy
             if bad[c, 0] < 0:
                 if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
                         and math.isfinite(y) and math.isfinite(stress[0, p])):
@@ -466,18 +481,26 @@ def _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_para
                 elif nvx * nvx + nvy * nvy > vmax * vmax:
                     bad[c, 0] = p
                     bad[c, 1] = STATUS_RUNAWAY
+            # the next extrapolation, from the new position and velocity
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            m = mass[p]
+            mvx = m * nvx
+            mvy = m * nvy
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            for b in range(NA):
+                sy = r[3 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    s = sy * r[a]
+                    k = row + a
+                    buf[GM, k] += s * m
+                    buf[GPX, k] += s * mvx
+                    buf[GPY, k] += s * mvy
 
 
-@njit(cache=True)
-def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
-    for q in range(pbc_part.size):
-        p = pbc_part[q]
-        d = pbc_dir[q]
-        rec_work[pbc_rec[q]] += pload[q] * (pos[d, p] - pos_before[q])
-
-
-@njit(cache=True)
-def advance(nsteps, t, dt, method, post_extrapolate, kind, plane_stress,
+@njit(cache=True, error_model="numpy")
+def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             pos, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp, mat_params,
             geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, mass_tol, vmax, left,
             leave_limit,
@@ -486,16 +509,19 @@ def advance(nsteps, t, dt, method, post_extrapolate, kind, plane_stress,
             sym_out, sym_in, sym_dir, bad, nch):
     """Run up to ``nsteps`` steps from time ``t`` (ms).
 
-    ``post_extrapolate`` selects NairnMPM's USL+/USAVG+ over the "-" variant.  In
-    "+" the last stress update of a step uses momenta extrapolated from the updated
-    particles, with the conditions at the new time: exactly the next step's first
-    grid.  So it is carried over and done in the next step's stress pass, with the
-    same velocity gradient, and only the chunk's last step does it on its own.
+    Every extrapolation after the chunk's first is fused into the particle update:
+    it is the next step's extrapolation in every method (positions and velocities do
+    not change in between), and in USL+/USAVG+ also NairnMPM's post-update one, whose
+    stress update is carried over (``pending``) into the next stress pass, which has
+    the same velocity gradient.  Shape-function weights are computed once per step.
     Returns (steps done, status, offending particle).  ``rec_force`` holds each
     condition's force (N) on the last step; ``rec_work`` accumulates its work (mJ).
     """
+    n = pos.shape[1]
     pload = np.zeros(pbc_part.size)
     pos_before = np.zeros(pbc_part.size)
+    wij = np.empty((n, 2), dtype=np.int64)
+    wc = np.empty((n, 12))
     if method == USF:
         dt_first = dt
         dt_last = 0.0
@@ -505,61 +531,65 @@ def advance(nsteps, t, dt, method, post_extrapolate, kind, plane_stress,
     else:
         dt_first = 0.5 * dt
         dt_last = dt - dt_first
-    dt_pending = 0.0
-    dt_in_update = 0.0 if post_extrapolate else dt_last
-    _pass_mass_momentum(pos, vel, mass, lp, geom, kind, gbuf, nch)
-    _reduce(gbuf, g, GM, GPY + 1, nch)
+    plus = post_extrapolate and dt_last > 0.0
+    _weights_and_mass(pos, vel, mass, lp, geom, wij, wc, gbuf, nch)
+    _reduce_velocity(gbuf, g, gv, mass_tol, nch)
     _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                          rec_ftime, sym_out, sym_in, sym_dir, t)
-    _grid_velocity(g, gv, mass_tol)
+    _velocity_at(g, gv, gbc_node, mass_tol)
+    _velocity_at(g, gv, sym_out, mass_tol)
+    pending = 0.0
     for step in range(nsteps):
         rec_force[:] = 0.0
-        _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                           plane_stress, geom, kind, gv, gbuf, nch, dt_pending, dt_first,
-                           True)
         g[GFX] = 0.0
         g[GFY] = 0.0
-        _scatter_loads(pos, lp, geom, kind, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+        _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                        rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
-        _add_forces(gbuf, g, nch)
-        _grid_update(g, gv, ga, gvn, dt, mass_tol)
+        _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
+                             geom, wij, wc, gv, gbuf, nch, pending, dt_first, True, n)
+        pending = 0.0
+        _forces_update(gbuf, g, ga, gvn, dt, mass_tol, nch)
         _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
                                    rec_value, rec_t0, rec_ftime, rec_force, rec_work,
                                    sym_out, sym_in, sym_dir, t, dt, mass_tol)
-        _pass_update_particles(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
-                               plane_stress, geom, kind, ga, gvn, dt, dt_in_update,
-                               damping, pdamp, bounds, vmax, left, bad, gbuf, nch)
+        _update_and_extrapolate(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
+                                plane_stress, geom, ga, gvn, dt,
+                                0.0 if post_extrapolate else dt_last, damping, pdamp,
+                                bounds, vmax, left, bad, wij, wc, gbuf, nch)
         _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
         t += dt
-        _reduce(gbuf, g, GM, GPY + 1, nch)
-        _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
-                             rec_ftime, sym_out, sym_in, sym_dir, t)
-        _grid_velocity(g, gv, mass_tol)
-        dt_pending = dt_last if post_extrapolate else 0.0
+        _reduce_velocity(gbuf, g, gv, mass_tol, nch)
+        _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
+                             rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
+        _velocity_at(g, gv, gbc_node, mass_tol)
+        _velocity_at(g, gv, sym_out, mass_tol)
+        if plus:
+            pending = dt_last
         n_left = 0
-        stop = False
-        status = STATUS_OK
-        who = -1
+        stop = -1
         for c in range(nch):
             if bad[c, 0] >= 0:
-                stop = True
-                status = bad[c, 1]
-                who = bad[c, 0]
+                stop = c
                 break
             n_left += bad[c, 2]
-        if not stop and n_left >= leave_limit:
+        status = STATUS_OK
+        who = -1
+        if stop >= 0:
+            status = bad[stop, 1]
+            who = bad[stop, 0]
+        elif n_left >= leave_limit:
             for c in range(nch):
                 if bad[c, 2] > 0:
-                    stop = True
                     status = STATUS_LEFT_GRID
                     who = bad[c, 3]
-        if stop or step == nsteps - 1:
-            if dt_pending > 0.0:
-                _pass_stress_force(pos, mass, vol0, lp, mat, F, stress, hist, w, mat_params,
-                                   plane_stress, geom, kind, gv, gbuf, nch, 0.0, dt_pending,
-                                   False)
-            if stop:
+                    break
+        if status != STATUS_OK or step == nsteps - 1:
+            if pending > 0.0:
+                _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params,
+                                     plane_stress, geom, wij, wc, gv, gbuf, nch, 0.0, pending,
+                                     False, n)
+            if status != STATUS_OK:
                 return step + 1, status, who
     return nsteps, STATUS_OK, -1

@@ -88,7 +88,8 @@ def _u_of_j(j, option):
     return 0.5 * lj * lj
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, inline="always", error_model="numpy",
+      fastmath={"contract", "reassoc", "nsz", "arcp", "afn"})
 def update(ip, dt, L00, L01, L10, L11, F, stress, hist, w, par, plane_stress):
     g = par[0]
     lam = par[1]
