@@ -6,9 +6,12 @@ frequency) with a name for the results columns; its members are grid nodes
 """
 from __future__ import annotations
 
+import ast
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 GRID_VELOCITY = "velocity"
 PARTICLE_LOAD = "load"
@@ -20,10 +23,52 @@ class ConditionRecord:
     kind: str        # GRID_VELOCITY or PARTICLE_LOAD
     direction: int   # 0 = x, 1 = y
     style: int
-    value: float
+    value: float     # for style 6: the factor on the expression (unit conversion)
     t0: float = 0.0
     ftime: float = 0.0
     n_members: int = 0
+    function: str | None = None   # style 6: expression of t (ms since t0)
+
+
+@njit(cache=True, inline="always")
+def no_condition_function(r, t):
+    """Stand-in when a scene has no style-6 condition (the kernels get a generated one)."""
+    return 0.0
+
+
+# what a style-6 expression may use (NairnMPM's expression language, t in ms)
+EXPRESSION_FUNCTIONS = {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh",
+                        "exp", "log", "log10", "sqrt", "abs", "floor", "ceil"}
+EXPRESSION_NAMES = {"t", "pi", "e"}
+
+
+def expression_source(text: str) -> str:
+    """Python source (math.* calls) of a NairnMPM expression of t; ValueError if it
+    uses anything else.  ``^`` is a power, as in NairnMPM."""
+    tree = ast.parse(text.replace("^", "**"), mode="eval")
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and node.id not in EXPRESSION_NAMES | EXPRESSION_FUNCTIONS:
+            raise ValueError(f"unknown name '{node.id}' (allowed: t, pi, e and "
+                             f"{', '.join(sorted(EXPRESSION_FUNCTIONS))})")
+        if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
+                                                and node.func.id in EXPRESSION_FUNCTIONS):
+            raise ValueError("only the listed functions may be called")
+        if not isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Call, ast.Name,
+                                 ast.Constant, ast.Load, ast.operator, ast.unaryop)):
+            raise ValueError(f"'{type(node).__name__}' is not allowed in an expression")
+
+    class ToMath(ast.NodeTransformer):
+        def visit_Name(self, node):
+            if node.id in EXPRESSION_FUNCTIONS or node.id in ("pi", "e"):
+                name = "fabs" if node.id == "abs" else node.id
+                return ast.copy_location(ast.Attribute(ast.Name("math", ast.Load()), name,
+                                                       ast.Load()), node)
+            return node
+    return ast.unparse(ast.fix_missing_locations(ToMath().visit(tree)))
+
+
+def evaluate_expression(text: str, t: float) -> float:
+    return float(eval(expression_source(text), {"math": math, "__builtins__": {}}, {"t": t}))
 
 
 @dataclass

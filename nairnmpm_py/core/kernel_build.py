@@ -18,9 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from . import step_kernels
+from .conditions import expression_source
 
 MARKER = "# KERNEL-MATERIALS"
 SHAPE_MARKER = "# KERNEL-SHAPE"
+FUNCTIONS_MARKER = "# KERNEL-FUNCTIONS"
 
 
 def cache_dir() -> Path:
@@ -71,9 +73,23 @@ def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.n
     return functions, table
 
 
-def load_kernels(update_functions: list[str], shape: int = 1):
+def _condition_source(expressions: dict[int, str]) -> str:
+    """``condition_function(r, t)``: the style-6 expression of record r at time t."""
+    lines = ["import math as _math_fn", "from numba import njit as _njit_fn", "", "",
+             "@_njit_fn(cache=True, inline='always')", "def condition_function(r, t):"]
+    for r, text in sorted(expressions.items()):
+        src = expression_source(text).replace("math.", "_math_fn.")
+        lines.append(f"    if r == {int(r)}:")
+        lines.append(f"        return {src}")
+    lines.append("    return 0.0")
+    return "\n".join(lines) + "\n"
+
+
+def load_kernels(update_functions: list[str], shape: int = 1,
+                 expressions: dict[int, str] | None = None):
     """Return the kernel module dispatching over these update functions (in order),
-    compiled for one kind of shape function (0 linear, 1 uGIMP)."""
+    compiled for one kind of shape function (0 linear, 1 uGIMP) and with the scene's
+    style-6 condition expressions (record index -> expression of t)."""
     template = Path(step_kernels.__file__).read_text()
     lines = template.splitlines()
     marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]
@@ -83,6 +99,11 @@ def load_kernels(update_functions: list[str], shape: int = 1):
                            "and one shape marker")
     lines[marked[0]] = _dispatch_source(update_functions)
     lines[shaped[0]] = f"KIND = {int(shape)}  # shape functions of this build"
+    if expressions:
+        fn = [i for i, line in enumerate(lines) if line.rstrip().endswith(FUNCTIONS_MARKER)]
+        if len(fn) != 1:
+            raise RuntimeError("step_kernels.py must have one condition-function marker")
+        lines[fn[0]] = _condition_source(expressions)
     source = "\n".join(lines) + "\n"
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
     name = f"nairnmpm_kernels_{digest}"

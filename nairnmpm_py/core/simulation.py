@@ -13,9 +13,10 @@ from typing import Callable
 
 import numba
 import numpy as np
+from scipy.integrate import quad
 
 from ..errors import SimulationUnstable
-from .conditions import GRID_VELOCITY, ConditionRecord, Conditions
+from .conditions import GRID_VELOCITY, ConditionRecord, Conditions, evaluate_expression
 from .grid import Grid
 from .kernel_build import load_kernels, material_table
 from .particles import Particles
@@ -108,6 +109,8 @@ class Simulation:
             return v * (1 - math.cos(w * s)) / w if w else 0.0
         if rec.style == 4:
             return v * math.sin(w * s) / w if w else v * s
+        if rec.style == 6:
+            return v * quad(lambda u: evaluate_expression(rec.function, u), 0.0, s, limit=200)[0]
         return 0.0
 
     def global_row(self) -> dict:
@@ -157,7 +160,9 @@ class Simulation:
         threads = numba.get_num_threads()
         if self.parallel is None:
             self.parallel = threads > 1 and p.n >= PARALLEL_MIN_PARTICLES
-        self.kernels = load_kernels(functions, self.shape)
+        expressions = {r: rec.function for r, rec in enumerate(self.conditions.records)
+                       if rec.style == 6}
+        self.kernels = load_kernels(functions, self.shape, expressions)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
         self.g = np.zeros((5, nn))

@@ -32,6 +32,7 @@ from numba import njit, prange
 
 from nairnmpm_py.core.shape import weights_1d
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
+from nairnmpm_py.core.conditions import no_condition_function as condition_function  # KERNEL-FUNCTIONS
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
@@ -60,11 +61,12 @@ def bc_active(style, t0, t):
 
 
 @njit(cache=True, inline="always")
-def bc_value(style, value, t0, ftime, t):
-    """Value of a boundary condition at time t (ms).
+def bc_value(r, style, value, t0, ftime, t):
+    """Value of boundary condition record r at time t (ms).
 
     style 1 constant, 2 linear ramp value*(t - t0) (value per ms),
-    3 value*sin(ftime*t), 4 value*cos(ftime*t) (ftime in rad/ms).
+    3 value*sin(ftime*t), 4 value*cos(ftime*t) (ftime in rad/ms), 6 value times the
+    record's expression of t - t0 (ms; zero before t0).
     """
     if style == 1:
         return value if t >= t0 else 0.0
@@ -74,6 +76,8 @@ def bc_value(style, value, t0, ftime, t):
         return value * math.sin(ftime * t)
     if style == 4:
         return value * math.cos(ftime * t)
+    if style == 6:
+        return value * condition_function(r, t - t0) if t >= t0 else 0.0
     return 0.0
 
 
@@ -85,7 +89,7 @@ def _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
     na = NA
     for q in range(pbc_part.size):
         r = pbc_rec[q]
-        f = pbc_scale[q] * bc_value(rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
+        f = pbc_scale[q] * bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
         pload[q] = f
         rec_force[r] += f
         p = pbc_part[q]
@@ -118,7 +122,7 @@ def _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, re
         r = gbc_rec[q]
         if bc_active(rec_style[r], rec_t0[r], t):
             k = gbc_node[q]
-            v = bc_value(rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
+            v = bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
             g[GPX + gbc_dir[q], k] += g[GM, k] * v
     for q in range(sym_out.size):
         ko = sym_out[q]
@@ -187,7 +191,7 @@ def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec
     for q in range(gbc_node.size):
         r = gbc_rec[q]
         if bc_active(rec_style[r], rec_t0[r], t):
-            gtmp[gbc_dir[q], gbc_node[q]] += bc_value(rec_style[r], rec_value[r], rec_t0[r],
+            gtmp[gbc_dir[q], gbc_node[q]] += bc_value(r, rec_style[r], rec_value[r], rec_t0[r],
                                                       rec_ftime[r], t + dt)
     for q in range(gbc_node.size):
         r = gbc_rec[q]

@@ -313,9 +313,11 @@ def _conditions(r: Reader, model: InputModel, grid: Grid, particles: Particles) 
             if members.size == 0:
                 r.problem(_at(cond.shape_line), f"<{cond.shape}> selects no grid nodes")
                 continue
+            # a function gives the velocity itself (mm/s): its factor is the unit change
+            value = 1.0 if cond.style == 6 else cond.value
             rec = ConditionRecord(f"bc{cond.line}_{axis_name}", GRID_VELOCITY, cond.direction - 1,
-                                  cond.style, cond.value * MM_PER_S_TO_MM_PER_MS, cond.time,
-                                  cond.ftime)
+                                  cond.style, value * MM_PER_S_TO_MM_PER_MS, cond.time,
+                                  cond.ftime, function=cond.function)
             conds.add_grid_velocity(rec, members)
             continue
         members = _select(r, cond, grid, particles.pos[0], particles.pos[1])
@@ -335,7 +337,8 @@ def _conditions(r: Reader, model: InputModel, grid: Grid, particles: Particles) 
             scale = sign * edge * particles.thick[members]
             axis_name = "x" if direction == 0 else "y"
         rec = ConditionRecord(f"bc{cond.line}_{axis_name}", PARTICLE_LOAD, direction,
-                              cond.style, cond.value, cond.time, cond.ftime)
+                              cond.style, 1.0 if cond.style == 6 else cond.value, cond.time,
+                              cond.ftime, function=cond.function)
         conds.add_particle_load(rec, members, scale)
     return conds
 

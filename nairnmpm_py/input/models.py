@@ -106,6 +106,7 @@ class ConditionModel(Model):
     value: float = 0.0           # mm/s, N or MPa
     time: float = 0.0            # ms (start of styles 1 and 2)
     ftime: float = 0.0           # rad/ms (styles 3 and 4)
+    function: str | None = None  # style 6: expression of t (ms since time)
     face: int | None = None
     net: bool = False
     shape: Literal["BCLine", "BCPt", "LdRect"]

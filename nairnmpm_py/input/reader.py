@@ -6,6 +6,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from .. import plugins
+from ..core.conditions import expression_source
 from ..errors import PluginError
 from .models import (AxisModel, BodyModel, ConditionModel, CrackModel, CrackPointModel,
                      CracksHeaderModel, GlobalArchiveModel, GridModel, InputModel,
@@ -397,7 +398,7 @@ def _conditions(r: Reader, el, out: list) -> None:
         for c in r.children(shape_el):
             if grid and c.tag == "DisBC":
                 a = r.attrs(c, {"dir": int, "vel": float, "style": int, "time": float,
-                                "ftime": float}, required=("dir",))
+                                "ftime": float, "function": str}, required=("dir",))
                 _append_condition(r, c, a, a.get("vel", 0.0), None, net, shape_el, coords, out)
             elif not grid and c.tag == "net":
                 r.attrs(c, {})
@@ -407,12 +408,14 @@ def _conditions(r: Reader, el, out: list) -> None:
                 net = False
             elif not grid and c.tag == "LoadBC":
                 a = r.attrs(c, {"dir": int, "load": float, "value": float, "style": int,
-                                "time": float, "ftime": float}, required=("dir",))
+                                "time": float, "ftime": float, "function": str},
+                            required=("dir",))
                 _append_condition(r, c, a, a.get("load", a.get("value", 0.0)), None, net,
                                   shape_el, coords, out)
             elif not grid and c.tag == "TractionBC":
                 a = r.attrs(c, {"dir": int, "face": int, "stress": float, "style": int,
-                                "time": float, "ftime": float}, required=("dir", "face"))
+                                "time": float, "ftime": float, "function": str},
+                            required=("dir", "face"))
                 if "face" in a and a["face"] not in (1, 2, 3, 4):
                     r.problem(c, "<TractionBC> face must be 1 (bottom), 2 (right), 3 (top) or 4 (left)")
                     continue
@@ -430,9 +433,21 @@ def _append_condition(r, c, a, value, face, net, shape_el, coords, out) -> None:
         r.problem(c, f"<{c.tag}> dir=\"{a['dir']}\": supported are " + ", ".join(map(str, allowed_dirs)))
         return
     style = a.get("style", 1)
-    if style not in (1, 2, 3, 4):
-        r.problem(c, f"<{c.tag}> style=\"{style}\": supported are 1 constant, 2 linear, 3 sine, 4 cosine")
+    if style not in (1, 2, 3, 4, 6):
+        r.problem(c, f"<{c.tag}> style=\"{style}\": supported are 1 constant, 2 linear, 3 sine, "
+                     "4 cosine, 6 function")
         return
+    function = a.get("function")
+    if (style == 6) != (function is not None):
+        r.problem(c, f"<{c.tag}> style 6 and the function attribute go together")
+        return
+    if function is not None:
+        try:
+            expression_source(function)
+        except (SyntaxError, ValueError) as exc:
+            msg = exc.msg if isinstance(exc, SyntaxError) else str(exc)
+            r.problem(c, f"<{c.tag}> function=\"{function}\": {msg}")
+            return
     if style in (3, 4):
         t0, ftime = 0.0, a.get("ftime", 0.0)
     else:
@@ -440,7 +455,8 @@ def _append_condition(r, c, a, value, face, net, shape_el, coords, out) -> None:
     if len(coords) < len(SHAPE_REQUIRED[shape_el.tag]):
         return
     out.append(ConditionModel(element=c.tag, direction=a["dir"], style=style, value=value,
-                              time=t0, ftime=ftime, face=face, net=net, shape=shape_el.tag,
+                              time=t0, ftime=ftime, function=function, face=face, net=net,
+                              shape=shape_el.tag,
                               coords=coords, shape_line=shape_el.sourceline, line=c.sourceline))
 
 
