@@ -43,8 +43,9 @@ def test_function_styles_match_built_in_styles(tmp_path):
 def test_expression_language():
     assert evaluate_expression("2*t^2 + sin(pi*t/2)", 1.0) == pytest.approx(3.0)
     assert evaluate_expression("abs(-t)+sqrt(4)", 3.0) == pytest.approx(5.0)
+    assert evaluate_expression("x*y + cos(q)", 0.0, x=2.0, y=3.0, q=0.0) == pytest.approx(7.0)
     with pytest.raises(ValueError):
-        evaluate_expression("x*t", 1.0)
+        evaluate_expression("z*t", 1.0)
     with pytest.raises(ValueError):
         evaluate_expression("__import__('os')", 1.0)
 
@@ -62,3 +63,29 @@ def test_bad_function_is_an_input_error(tmp_path, capsys, attrs, message):
     err = capsys.readouterr().err
     assert f"{path}:{line_of(text, '<LoadBC')}:" in err and message in err
     assert not out.exists()
+
+
+def test_particle_loads_can_turn_with_their_particles(tmp_path):
+    """NairnMPM's way to make a force follow its particle: two style-6 loads using the
+    particle rotation q (the DCB moment loading of the paper)."""
+    turned = SCENE.replace("GRIDBC", 'style="1" vel="0"').replace(
+        '<LoadBC dir="1" LOADBC/>',
+        '<LoadBC dir="1" style="6" function="10*cos(q)"/><LoadBC dir="2" style="6" function="10*sin(q)"/>')
+    sim = build(tmp_path, turned, "turned.xml")
+    angle = 0.3
+    c, s = np.cos(angle), np.sin(angle)
+    sim.particles.F[0], sim.particles.F[1] = c, -s
+    sim.particles.F[2], sim.particles.F[3] = s, c
+    sim.max_time = sim.dt  # one step: the rotation has not changed yet
+    rec = Recorder()
+    sim.run([rec])
+    fx = [v for k, v in rec.rows[-1].items() if k.startswith("load_N_") and k.endswith("_x")][-1]
+    fy = [v for k, v in rec.rows[-1].items() if k.startswith("load_N_") and k.endswith("_y")][-1]
+    assert fx == pytest.approx(10 * c, rel=1e-6) and fy == pytest.approx(10 * s, rel=1e-6)
+
+
+def test_grid_conditions_have_no_rotation(tmp_path, capsys):
+    text = SCENE.replace("GRIDBC", 'style="6" function="cos(q)"').replace("LOADBC", 'load="1"')
+    path = write(tmp_path, text)
+    assert main(["check", str(path)]) == 2
+    assert "unknown name 'q'" in capsys.readouterr().err

@@ -31,25 +31,27 @@ class ConditionRecord:
 
 
 @njit(cache=True, inline="always")
-def no_condition_function(r, t):
+def no_condition_function(r, t, x, y, q):
     """Stand-in when a scene has no style-6 condition (the kernels get a generated one)."""
     return 0.0
 
 
-# what a style-6 expression may use (NairnMPM's expression language, t in ms)
+# what a style-6 expression may use (NairnMPM's expression language): t in ms since
+# the condition's start; x, y the node or particle position (mm); q the particle's
+# rotation (radians, counter-clockwise), so a load can turn with its particle
 EXPRESSION_FUNCTIONS = {"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh",
                         "exp", "log", "log10", "sqrt", "abs", "floor", "ceil"}
-EXPRESSION_NAMES = {"t", "pi", "e"}
+EXPRESSION_NAMES = {"t", "x", "y", "q", "pi", "e"}
 
 
-def expression_source(text: str) -> str:
-    """Python source (math.* calls) of a NairnMPM expression of t; ValueError if it
-    uses anything else.  ``^`` is a power, as in NairnMPM."""
+def expression_source(text: str, names: set[str] = EXPRESSION_NAMES) -> str:
+    """Python source (math.* calls) of a NairnMPM expression; ValueError if it uses
+    anything but ``names`` and the listed functions.  ``^`` is a power, as in NairnMPM."""
     tree = ast.parse(text.replace("^", "**"), mode="eval")
     for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and node.id not in EXPRESSION_NAMES | EXPRESSION_FUNCTIONS:
-            raise ValueError(f"unknown name '{node.id}' (allowed: t, pi, e and "
-                             f"{', '.join(sorted(EXPRESSION_FUNCTIONS))})")
+        if isinstance(node, ast.Name) and node.id not in names | EXPRESSION_FUNCTIONS:
+            raise ValueError(f"unknown name '{node.id}' (allowed: {', '.join(sorted(names))} "
+                             f"and {', '.join(sorted(EXPRESSION_FUNCTIONS))})")
         if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
                                                 and node.func.id in EXPRESSION_FUNCTIONS):
             raise ValueError("only the listed functions may be called")
@@ -67,8 +69,10 @@ def expression_source(text: str) -> str:
     return ast.unparse(ast.fix_missing_locations(ToMath().visit(tree)))
 
 
-def evaluate_expression(text: str, t: float) -> float:
-    return float(eval(expression_source(text), {"math": math, "__builtins__": {}}, {"t": t}))
+def evaluate_expression(text: str, t: float, x: float = 0.0, y: float = 0.0,
+                        q: float = 0.0) -> float:
+    return float(eval(expression_source(text), {"math": math, "__builtins__": {}},
+                      {"t": t, "x": x, "y": y, "q": q}))
 
 
 @dataclass

@@ -74,9 +74,9 @@ def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.n
 
 
 def _condition_source(expressions: dict[int, str]) -> str:
-    """``condition_function(r, t)``: the style-6 expression of record r at time t."""
+    """``condition_function(r, t, x, y, q)``: the style-6 expression of record r."""
     lines = ["import math as _math_fn", "from numba import njit as _njit_fn", "", "",
-             "@_njit_fn(cache=True, inline='always')", "def condition_function(r, t):"]
+             "@_njit_fn(cache=True, inline='always')", "def condition_function(r, t, x, y, q):"]
     for r, text in sorted(expressions.items()):
         src = expression_source(text).replace("math.", "_math_fn.")
         lines.append(f"    if r == {int(r)}:")

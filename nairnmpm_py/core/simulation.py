@@ -109,7 +109,7 @@ class Simulation:
             return v * (1 - math.cos(w * s)) / w if w else 0.0
         if rec.style == 4:
             return v * math.sin(w * s) / w if w else v * s
-        if rec.style == 6:
+        if rec.style == 6:  # (a position-dependent expression is taken at x = y = 0)
             return v * quad(lambda u: evaluate_expression(rec.function, u), 0.0, s, limit=200)[0]
         return 0.0
 

@@ -61,12 +61,13 @@ def bc_active(style, t0, t):
 
 
 @njit(cache=True, inline="always")
-def bc_value(r, style, value, t0, ftime, t):
+def bc_value(r, style, value, t0, ftime, t, x, y, q):
     """Value of boundary condition record r at time t (ms).
 
     style 1 constant, 2 linear ramp value*(t - t0) (value per ms),
     3 value*sin(ftime*t), 4 value*cos(ftime*t) (ftime in rad/ms), 6 value times the
-    record's expression of t - t0 (ms; zero before t0).
+    record's expression of t - t0 (ms; zero before t0), of the position x, y (mm) of
+    the node or particle and of the particle's rotation q (radians).
     """
     if style == 1:
         return value if t >= t0 else 0.0
@@ -77,22 +78,39 @@ def bc_value(r, style, value, t0, ftime, t):
     if style == 4:
         return value * math.cos(ftime * t)
     if style == 6:
-        return value * condition_function(r, t - t0) if t >= t0 else 0.0
+        return value * condition_function(r, t - t0, x, y, q) if t >= t0 else 0.0
     return 0.0
 
 
+@njit(cache=True, inline="always")
+def node_x(k, geom):
+    return geom[0] + (k % int(geom[4])) * geom[2]
+
+
+@njit(cache=True, inline="always")
+def node_y(k, geom):
+    return geom[1] + (k // int(geom[4])) * geom[3]
+
+
+@njit(cache=True, inline="always")
+def particle_rotation(F, p):
+    """Rotation (radians, counter-clockwise) of the polar decomposition of F."""
+    return math.atan2(F[2, p] - F[1, p], F[0, p] + F[3, p])
+
+
 @njit(cache=True, error_model="numpy")
-def _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                    rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
     """Particle loads (N) at time t onto the grid; pload keeps them for the work."""
     nnx = int(geom[4])
     na = NA
     for q in range(pbc_part.size):
         r = pbc_rec[q]
-        f = pbc_scale[q] * bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
+        p = pbc_part[q]
+        f = pbc_scale[q] * bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
+                                    pos[0, p], pos[1, p], particle_rotation(F, p))
         pload[q] = f
         rec_force[r] += f
-        p = pbc_part[q]
         row_c = GFX + pbc_dir[q]
         xi = (pos[0, p] - geom[0]) / geom[2]
         eta = (pos[1, p] - geom[1]) / geom[3]
@@ -107,7 +125,7 @@ def _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
 
 
 @njit(cache=True, error_model="numpy")
-def _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+def _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                          rec_ftime, sym_out, sym_in, sym_dir, t):
     """Impose velocity conditions on the extrapolated momenta.
 
@@ -122,7 +140,8 @@ def _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, re
         r = gbc_rec[q]
         if bc_active(rec_style[r], rec_t0[r], t):
             k = gbc_node[q]
-            v = bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t)
+            v = bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
+                         node_x(k, geom), node_y(k, geom), 0.0)
             g[GPX + gbc_dir[q], k] += g[GM, k] * v
     for q in range(sym_out.size):
         ko = sym_out[q]
@@ -180,7 +199,7 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
 
 
 @njit(cache=True, error_model="numpy")
-def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
+def _velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
                                rec_value, rec_t0, rec_ftime, rec_force, rec_work,
                                sym_out, sym_in, sym_dir, t, dt, mass_tol):
     """Impose v(t+dt) on conditioned nodes; the force that takes is the reaction."""
@@ -191,8 +210,10 @@ def _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec
     for q in range(gbc_node.size):
         r = gbc_rec[q]
         if bc_active(rec_style[r], rec_t0[r], t):
-            gtmp[gbc_dir[q], gbc_node[q]] += bc_value(r, rec_style[r], rec_value[r], rec_t0[r],
-                                                      rec_ftime[r], t + dt)
+            k = gbc_node[q]
+            gtmp[gbc_dir[q], k] += bc_value(r, rec_style[r], rec_value[r], rec_t0[r],
+                                            rec_ftime[r], t + dt, node_x(k, geom),
+                                            node_y(k, geom), 0.0)
     for q in range(gbc_node.size):
         r = gbc_rec[q]
         k = gbc_node[q]
@@ -538,7 +559,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     plus = post_extrapolate and dt_last > 0.0
     _weights_and_mass(pos, vel, mass, lp, geom, wij, wc, gbuf, nch)
     _reduce_velocity(gbuf, g, gv, mass_tol, nch)
-    _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+    _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                          rec_ftime, sym_out, sym_in, sym_dir, t)
     _velocity_at(g, gv, gbc_node, mass_tol)
     _velocity_at(g, gv, sym_out, mass_tol)
@@ -547,7 +568,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         rec_force[:] = 0.0
         g[GFX] = 0.0
         g[GFY] = 0.0
-        _scatter_loads(pos, lp, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+        _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                        rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
@@ -555,7 +576,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                              geom, wij, wc, gv, gbuf, nch, pending, dt_first, True, n)
         pending = 0.0
         _forces_update(gbuf, g, ga, gvn, dt, mass_tol, nch)
-        _velocity_conditions_after(g, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
+        _velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
                                    rec_value, rec_t0, rec_ftime, rec_force, rec_work,
                                    sym_out, sym_in, sym_dir, t, dt, mass_tol)
         _update_and_extrapolate(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
@@ -565,7 +586,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
         t += dt
         _reduce_velocity(gbuf, g, gv, mass_tol, nch)
-        _momentum_conditions(g, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
+        _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
                              rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
         _velocity_at(g, gv, gbc_node, mass_tol)
         _velocity_at(g, gv, sym_out, mass_tol)

@@ -6,7 +6,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from .. import plugins
-from ..core.conditions import expression_source
+from ..core.conditions import EXPRESSION_NAMES, expression_source
 from ..errors import PluginError
 from .models import (AxisModel, BodyModel, ConditionModel, CrackModel, CrackPointModel,
                      CracksHeaderModel, GlobalArchiveModel, GridModel, InputModel,
@@ -442,8 +442,10 @@ def _append_condition(r, c, a, value, face, net, shape_el, coords, out) -> None:
         r.problem(c, f"<{c.tag}> style 6 and the function attribute go together")
         return
     if function is not None:
+        # a grid node has a position but no rotation
+        names = EXPRESSION_NAMES - {"q"} if c.tag == "DisBC" else EXPRESSION_NAMES
         try:
-            expression_source(function)
+            expression_source(function, names)
         except (SyntaxError, ValueError) as exc:
             msg = exc.msg if isinstance(exc, SyntaxError) else str(exc)
             r.problem(c, f"<{c.tag}> function=\"{function}\": {msg}")
