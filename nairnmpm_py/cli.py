@@ -139,6 +139,11 @@ def cmd_plugins(args) -> int:
 def cmd_plot(args) -> int:
     from .analysis.plots import plot_results
     folder = Path(args.dir)
+    if (folder / "summary.csv").exists():        # a sweep folder: overlay its members
+        from .analysis.sweep_plots import plot_sweep
+        for f in plot_sweep(folder, Path(args.output) if args.output else None):
+            print(f)
+        return EXIT_OK
     if not (folder / "run.json").exists() and not (folder / "global.csv").exists():
         print(f"{folder}: not a results folder (no run.json or global.csv)", file=sys.stderr)
         return EXIT_INPUT
@@ -170,6 +175,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_plot)
     from .analysis import rcurve_cli
     rcurve_cli.add_parser(sub)
+    from . import sweep_cli
+    sweep_cli.add_parser(sub)
     return ap
 
 

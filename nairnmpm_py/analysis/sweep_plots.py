@@ -1,0 +1,82 @@
+"""Overlay plots of a sweep folder (``summary.csv`` plus one results folder per member):
+energies against time and each load against displacement (or time), one line per
+member, legend by member name."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from .plots import (DISP_PREFIX, ENERGY_COLUMNS, LOAD_PREFIXES, TIME_LABEL, _figure,
+                    _nonzero, _safe, _save)
+from .results import read_csv_columns
+
+SUMMARY = "summary.csv"
+
+
+def sweep_members(folder) -> list[tuple[str, dict, list[str]]]:
+    """(name, global.csv columns, column order) of every member of ``folder`` that has a
+    non-empty global.csv, in summary order."""
+    folder = Path(folder)
+    with open(folder / SUMMARY, newline="") as f:
+        names = [r["name"] for r in csv.DictReader(f) if r.get("name")]
+    members = []
+    for name in names:
+        g = folder / name / "global.csv"
+        if not g.exists():
+            continue
+        try:
+            cols, data = read_csv_columns(g)
+        except Exception:
+            continue
+        if "time_ms" in data and len(data["time_ms"]):
+            members.append((name, data, cols))
+    return members
+
+
+def plot_sweep(folder, out_folder=None) -> list[Path]:
+    """PNGs overlaying the members of a sweep into ``out_folder`` (default
+    ``folder/plots``): ``sweep_energies.png`` (one panel per energy) and
+    ``sweep_load_<bc>.png`` per load column (load vs displacement, else vs time).
+    Returns the files written."""
+    folder = Path(folder)
+    out = Path(out_folder) if out_folder is not None else folder / "plots"
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    members = sweep_members(folder)
+    if not members:
+        return written
+
+    energies = [c for c in ENERGY_COLUMNS if any(c in g for _, g, _ in members)]
+    if energies:
+        fig, axes = _figure(len(energies))
+        for ax, col in zip(axes, energies):
+            for name, g, _ in members:
+                if col in g:
+                    ax.plot(g["time_ms"], g[col], label=name)
+            ax.set_xlabel(TIME_LABEL)
+            ax.set_ylabel(f"{ENERGY_COLUMNS[col]} energy (J)")
+            ax.grid(alpha=0.3)
+        axes[0].legend(fontsize="small")
+        _save(fig, out / "sweep_energies.png", written)
+
+    load_cols = []
+    for _, _, cols in members:
+        load_cols += [c for c in cols if c not in load_cols and any(c.startswith(p) for p in LOAD_PREFIXES)]
+    for col in load_cols:
+        prefix = next(p for p in LOAD_PREFIXES if col.startswith(p))
+        bc = col[len(prefix):]
+        disp_col = DISP_PREFIX + bc
+        have = [(n, g) for n, g, _ in members if col in g and _nonzero(g[col])]
+        if not have:
+            continue
+        vs_disp = all(disp_col in g and _nonzero(g[disp_col]) for _, g in have)
+        fig, (ax,) = _figure()
+        for name, g in have:
+            ax.plot(g[disp_col] if vs_disp else g["time_ms"], g[col], label=name)
+        ax.set_xlabel("displacement (mm)" if vs_disp else TIME_LABEL)
+        ax.set_ylabel(LOAD_PREFIXES[prefix])
+        ax.set_title(f"boundary condition {bc}")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+        _save(fig, out / f"sweep_load_{_safe(bc)}.png", written)
+    return written
