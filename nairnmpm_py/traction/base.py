@@ -32,9 +32,10 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, field_validator
+from pydantic import BaseModel, ConfigDict, field_validator, model_validator
 from scipy.integrate import quad
 from scipy.optimize import minimize_scalar
 from scipy.special import roots_legendre
@@ -72,6 +73,18 @@ class TractionParams(BaseModel):
             raise ValueError(f"must be >= 0 (got {v:g})")
         return v
 
+    def resolve(self, mode: int):
+        """The resolved constants of one mode, None when that mode carries no traction;
+        raises ValueError on an inconsistent set.  Each law defines it."""
+        return None
+
+    @model_validator(mode="after")
+    def _modes_consistent(self):
+        # every law is checked the same way: both modes must resolve
+        self.resolve(1)
+        self.resolve(2)
+        return self
+
 
 def given(params: BaseModel, *names: str) -> list[str]:
     """The names among ``names`` that were given (not None) in ``params``."""
@@ -103,6 +116,25 @@ def two_of_three(params: BaseModel, names: tuple[str, str, str], factor: float,
     else:
         J = MPA_MM_TO_J_M2 * factor * sigma * delta_c
     return sigma, delta_c, J
+
+
+class SigmaDeltaJParams(TractionParams):
+    """Per mode, two of the peak stress, critical COD and area, as NairnMPM names them
+    (mode II may be left out); ``area_factor`` is J / (sigma delta_c) for the law's
+    shape."""
+    area_factor: ClassVar[float] = 0.5
+    sigmaI: float | None = None   # MPa
+    delIc: float | None = None    # mm
+    JIc: float | None = None      # J/m^2
+    sigmaII: float | None = None
+    delIIc: float | None = None
+    JIIc: float | None = None
+
+    def resolve(self, mode: int) -> tuple[float, float, float] | None:
+        """(sigma MPa, delta_c mm, J J/m^2) of one mode, or None for an absent mode II."""
+        m = MODE_NAMES[mode_number(mode)]
+        return two_of_three(self, (f"sigma{m}", f"del{m}c", f"J{m}c"), self.area_factor,
+                            required=(mode_number(mode) == 1))
 
 
 # ---- one resolved mode --------------------------------------------------------------

@@ -21,7 +21,6 @@ import math
 
 import numpy as np
 from numba import njit
-from pydantic import model_validator
 
 from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, given
 
@@ -40,11 +39,8 @@ class ExponentialParams(TractionParams):
     JIIc: float | None = None
     alphaII: float | None = None
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        resolve(self, 1)
-        resolve(self, 2)
-        return self
+    def resolve(self, mode: int):
+        return resolve(self, mode)
 
 
 def area_factor(alpha: float) -> float:

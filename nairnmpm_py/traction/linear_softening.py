@@ -12,32 +12,16 @@ or absent.
 """
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from numba import njit
-from pydantic import model_validator
 
-from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, two_of_three
-
-
-class LinearSofteningParams(TractionParams):
-    sigmaI: float | None = None   # MPa
-    delIc: float | None = None    # mm
-    JIc: float | None = None      # J/m^2
-    sigmaII: float | None = None
-    delIIc: float | None = None
-    JIIc: float | None = None
-
-    @model_validator(mode="after")
-    def _consistent(self):
-        resolve(self, 1)
-        resolve(self, 2)
-        return self
+from .base import ModeSpec, SigmaDeltaJParams, TractionLaw
 
 
-def resolve(p: LinearSofteningParams, mode: int) -> tuple[float, float, float] | None:
-    """(sigma MPa, delta_c mm, J J/m^2) of one mode, or None for an absent mode II."""
-    m = MODE_NAMES[mode]
-    return two_of_three(p, (f"sigma{m}", f"del{m}c", f"J{m}c"), 0.5, required=(mode == 1))
+class LinearSofteningParams(SigmaDeltaJParams):
+    area_factor: ClassVar[float] = 0.5
 
 
 class LinearSoftening(TractionLaw):
@@ -47,7 +31,7 @@ class LinearSoftening(TractionLaw):
     envelope_function = "nairnmpm_py.traction.linear_softening:envelope"
 
     def mode_spec(self, mode):
-        r = resolve(self.params, mode)
+        r = self.params.resolve(mode)
         if r is None:
             return None
         sigma, delta_c, J = r

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from pydantic import model_validator
 
 from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, given, two_of_three
 
@@ -35,11 +34,8 @@ class TriangularParams(TractionParams):
     delpkII: float | None = None
     kIIe: float | None = None
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        resolve(self, 1)
-        resolve(self, 2)
-        return self
+    def resolve(self, mode: int):
+        return resolve(self, mode)
 
 
 def resolve(p: TriangularParams, mode: int) -> tuple[float, float, float, float] | None:

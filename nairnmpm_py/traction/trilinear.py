@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from pydantic import model_validator
 
 from .base import MODE_NAMES, ModeSpec, TractionLaw, TractionParams, given
 
@@ -39,11 +38,8 @@ class TrilinearParams(TractionParams):
     delIIc: float | None = None
     JIIc: float | None = None
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        resolve(self, 1)
-        resolve(self, 2)
-        return self
+    def resolve(self, mode: int):
+        return resolve(self, mode)
 
 
 def resolve(p: TrilinearParams, mode: int) -> tuple[float, ...] | None:
