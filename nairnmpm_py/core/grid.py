@@ -49,8 +49,8 @@ class Grid:
                          self.dx, self.dy, float(self.nodes_x)])
 
     def bounds(self) -> np.ndarray:
-        """Region particles must stay in: the real grid less a margin the shape
-        functions need, so no particle ever touches a node beyond the ghosts."""
+        """Region particles must stay in: the real grid; the ghost layer beyond it is
+        what uGIMP reaches from its edge cells (NairnMPM's extra cell layer)."""
         return np.array([self.xmin, self.xmax, self.ymin, self.ymax])
 
     def node_index(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:

@@ -13,7 +13,6 @@ from numba import njit
 
 LINEAR = 0
 UGIMP = 1
-NODES_PER_AXIS = (2, 3)
 
 
 @njit(cache=True, inline="always")

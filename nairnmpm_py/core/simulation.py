@@ -92,9 +92,6 @@ class Simulation:
         return int(math.ceil(self.max_time / self.dt - 1e-9))
 
     # ---- results helpers -------------------------------------------------------
-    def record_names(self) -> list[str]:
-        return [r.name for r in self.conditions.records]
-
     def prescribed_displacement(self, r: int, t: float) -> float:
         """Displacement (mm) a grid velocity condition has imposed by time t."""
         rec = self.conditions.records[r]

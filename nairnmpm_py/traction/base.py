@@ -264,6 +264,20 @@ class TractionLaw:
                             tuple(spec.breakpoints))
 
 
+class SigmaDeltaJLaw(TractionLaw):
+    """A law fixed by sigma, delta_c and J per mode (``SigmaDeltaJParams``), whose
+    envelope takes (delta_c, sigma) and peaks at ``peak_fraction`` * delta_c."""
+    peak_fraction: float = 0.0
+
+    def mode_spec(self, mode):
+        r = self.params.resolve(mode)
+        if r is None:
+            return None
+        sigma, delta_c, J = r
+        return ModeSpec(delta_c=delta_c, par=np.array([delta_c, sigma]), peak_stress=sigma,
+                        peak_delta=self.peak_fraction * delta_c, area=J)
+
+
 def load_envelope_function(law):
     """Import the law's jitted envelope from its ``"module:function"`` string."""
     target = law.envelope_function

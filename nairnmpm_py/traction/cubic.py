@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from .base import ModeSpec, SigmaDeltaJParams, TractionLaw
+from .base import SigmaDeltaJLaw, SigmaDeltaJParams
 
 AREA_FACTOR = 9.0 / 16.0
 
@@ -23,19 +23,12 @@ class CubicParams(SigmaDeltaJParams):
     area_factor: ClassVar[float] = AREA_FACTOR
 
 
-class Cubic(TractionLaw):
+class Cubic(SigmaDeltaJLaw):
     name = "Cubic"
     nairn_type = 14
     Params = CubicParams
     envelope_function = "nairnmpm_py.traction.cubic:envelope"
-
-    def mode_spec(self, mode):
-        r = self.params.resolve(mode)
-        if r is None:
-            return None
-        sigma, delta_c, J = r
-        return ModeSpec(delta_c=delta_c, par=np.array([delta_c, sigma]),
-                        peak_stress=sigma, peak_delta=delta_c / 3.0, area=J)
+    peak_fraction = 1.0 / 3.0
 
     def envelope_array(self, delta, par):
         x = delta / par[0]

@@ -17,26 +17,19 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from .base import ModeSpec, SigmaDeltaJParams, TractionLaw
+from .base import SigmaDeltaJLaw, SigmaDeltaJParams
 
 
 class LinearSofteningParams(SigmaDeltaJParams):
     area_factor: ClassVar[float] = 0.5
 
 
-class LinearSoftening(TractionLaw):
+class LinearSoftening(SigmaDeltaJLaw):
     name = "LinearSoftening"
     nairn_type = None
     Params = LinearSofteningParams
     envelope_function = "nairnmpm_py.traction.linear_softening:envelope"
-
-    def mode_spec(self, mode):
-        r = self.params.resolve(mode)
-        if r is None:
-            return None
-        sigma, delta_c, J = r
-        return ModeSpec(delta_c=delta_c, par=np.array([delta_c, sigma]),
-                        peak_stress=sigma, peak_delta=0.0, area=J)
+    peak_fraction = 0.0
 
     def envelope_array(self, delta, par):
         return par[1] * (1.0 - delta / par[0])
