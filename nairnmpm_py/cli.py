@@ -24,6 +24,21 @@ def _print_problems(exc) -> None:
         print(p, file=sys.stderr)
 
 
+def _crack_summary(sim) -> str:
+    scene = getattr(sim, "cracks", None)
+    if scene is None:
+        return "cracks:     none"
+    cs = scene.cracks
+    parts = []
+    for c in range(cs.n_cracks):
+        s, n = cs.first[c], cs.count[c]
+        with_law = int((cs.law[s:s + n] >= 0).sum())
+        tips = [t.end for t in scene.tips if t.crack == c]
+        parts.append(f"crack {c + 1}: {n} particles, {with_law} with traction laws, "
+                     f"J at {' and '.join(tips) + ' tip' if tips else 'no tip'}")
+    return "cracks:     " + "; ".join(parts) + f" (J contour {scene.jcontour_size} cells)"
+
+
 def _summary(sim) -> str:
     from .core.simulation import METHOD_NAMES, SHAPE_NAMES
     p, g = sim.particles, sim.grid
@@ -39,7 +54,7 @@ def _summary(sim) -> str:
             f"{n} ({m.name}, {int((p.mat == i).sum())} particles, wave speed {m.wave_speed():.4g} m/s)"
             if hasattr(m, "wave_speed") else f"{n} ({m.name} traction law)"
             for i, (n, m) in enumerate(zip(sim.material_names, sim.materials))),
-        "cracks:     none",
+        _crack_summary(sim),
         f"time step:  {sim.dt:.6g} ms (CFL limit {sim.cfl_time_step():.6g} ms at factor {sim.cfl:g})",
         f"max time:   {sim.max_time:g} ms, about {sim.n_steps} steps",
         f"conditions: {len(sim.conditions.records)} ("

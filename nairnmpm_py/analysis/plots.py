@@ -207,6 +207,9 @@ def _plot_jcontours(j: dict, columns: list[str], out: Path, written: list[Path])
     ycols = [c for c in columns if c.startswith("J") and c.endswith("_J_m2") and c != xcol]
     if xcol is None or not ycols or len(j[xcol]) == 0:
         return
+    if "time_ms" in j:   # the last time written (every archive has all sizes)
+        last = np.flatnonzero(j["time_ms"] == np.max(j["time_ms"]))
+        j = {k: np.asarray(v)[last] for k, v in j.items()}
     order = np.argsort(j[xcol], kind="stable")
     fig, (ax,) = _figure()
     for col in ycols:

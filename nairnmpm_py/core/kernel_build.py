@@ -105,8 +105,26 @@ def load_kernels(update_functions: list[str], shape: int = 1,
             raise RuntimeError("step_kernels.py must have one condition-function marker")
         lines[fn[0]] = _condition_source(expressions)
     source = "\n".join(lines) + "\n"
-    digest = hashlib.sha256(source.encode()).hexdigest()[:16]
-    name = f"nairnmpm_kernels_{digest}"
+    return _load_source(source, "nairnmpm_kernels", update_functions + ["nairnmpm_py.core.shape:x"])
+
+
+def _dependency_text(refs: list[str]) -> str:
+    """Source of the modules a generated file imports functions from: Numba's cache
+    of a function does not notice when a function it calls changes, so the file name
+    (and with it the cache) must change with them."""
+    out = []
+    for module in sorted({ref.split(":")[0] for ref in refs}):
+        try:
+            spec = importlib.util.find_spec(module)
+            out.append(Path(spec.origin).read_text() if spec and spec.origin else module)
+        except (ImportError, OSError, ValueError):
+            out.append(module)
+    return "\n".join(out)
+
+
+def _load_source(source: str, prefix: str, refs: list[str]):
+    digest = hashlib.sha256((source + _dependency_text(refs)).encode()).hexdigest()[:16]
+    name = f"{prefix}_{digest}"
     if name in sys.modules:
         return sys.modules[name]
     folder = cache_dir()
@@ -121,3 +139,40 @@ def load_kernels(update_functions: list[str], shape: int = 1,
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+CRACK_BASE_MARKER = "# KERNEL-BASE"
+TRACTION_MARKER = "# KERNEL-TRACTION"
+CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.fields:x"]
+
+
+def _traction_source(functions: list[str]) -> str:
+    """``traction_envelope(kind, delta, par)``: envelope ``kind`` of the scene's laws."""
+    lines = ["from numba import njit as _njit_traction"]
+    for i, ref in enumerate(functions):
+        module, func = ref.split(":")
+        lines.append(f"from {module} import {func} as _envelope_{i}")
+    lines += ["", "", "@_njit_traction(cache=True, inline='always')",
+              "def traction_envelope(kind, delta, par):"]
+    for i in range(len(functions)):
+        lines.append(f"    if kind == {i}:")
+        lines.append(f"        return _envelope_{i}(delta, par)")
+    lines.append("    return 0.0")
+    return "\n".join(lines) + "\n"
+
+
+def load_crack_kernels(base, envelope_functions: list[str]):
+    """The crack step for a scene whose no-crack kernels are ``base`` (from
+    ``load_kernels``), dispatching over these traction envelopes ("module:function",
+    index = kind in the law tables)."""
+    from . import crack_step_kernels
+    lines = Path(crack_step_kernels.__file__).read_text().splitlines()
+    based = [i for i, line in enumerate(lines) if line.rstrip().endswith(CRACK_BASE_MARKER)]
+    traced = [i for i, line in enumerate(lines) if line.rstrip().endswith(TRACTION_MARKER)]
+    if len(based) != 1 or len(traced) != 1:
+        raise RuntimeError("crack_step_kernels.py must have one base and one traction marker")
+    lines[based[0]] = lines[based[0]].replace("nairnmpm_py.core.step_kernels", base.__name__)
+    lines[traced[0]] = _traction_source(envelope_functions)
+    source = "\n".join(lines) + "\n"
+    return _load_source(source, "nairnmpm_crack_kernels",
+                        envelope_functions + CRACK_DEPENDENCIES + [base.__name__ + ":x"])

@@ -29,7 +29,8 @@ METHOD_NAMES = {0: "USF", 2: "USAVG", 3: "USL"}
 SHAPE_NAMES = {LINEAR: "linear", UGIMP: "uGIMP"}
 STATUS_TEXT = {1: "a value became NaN or infinite",
                2: "too many particles left the grid (LeaveLimit); the last one was",
-               3: "a particle velocity ran away (time step too large for stability?)"}
+               3: "a particle velocity ran away (time step too large for stability?)",
+               4: "a crack particle left the grid:"}
 
 
 @dataclass
@@ -63,6 +64,7 @@ class Simulation:
     title: str = ""
     source: dict = field(default_factory=dict)   # input path, sha256, parsed text
     material_names: list = field(default_factory=list)
+    cracks: object = None      # cracks.scene.CrackScene, or None for a scene without cracks
 
     def __post_init__(self):
         self.time = 0.0
@@ -181,6 +183,8 @@ class Simulation:
         speeds = [self.max_wave_speed(), float(np.max(np.abs(p.vel))) if p.n else 0.0]
         speeds += [abs(r.value) for r in self.conditions.records if r.kind == GRID_VELOCITY]
         self.vmax = 20.0 * max(speeds)
+        if self.cracks is not None:
+            self.cracks.prepare(self)
 
     def _add_symmetry_planes(self) -> None:
         """Zero normal velocity on every node of each symmetry plane (a wall); the
@@ -236,20 +240,29 @@ class Simulation:
         if not self.parallel:
             numba.set_num_threads(1)  # one chunk: no thread pool, no barriers
         try:
-            done, status, bad = self.kernels.advance(
-                nsteps, self.time, self.dt, self.method, self.post_extrapolate,
-                self.plane_stress, p.pos, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F,
-                p.stress, p.hist, p.w, p.pdamp, self.mat_params, self.geom, self.bounds,
-                self.g, self.gbuf, self.gv, self.ga, self.gvn, self.gtmp, self.damping,
-                self.mass_tol, self.vmax, self.left, self.leave_max,
-                c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-                c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
-                c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
-                self.sym_dir, self.bad, self.nch)
+            if self.cracks is not None:
+                done, status, bad = self.cracks.advance(self, nsteps)
+            else:
+                done, status, bad = self.kernels.advance(
+                    nsteps, self.time, self.dt, self.method, self.post_extrapolate,
+                    self.plane_stress, p.pos, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F,
+                    p.stress, p.hist, p.w, p.pdamp, self.mat_params, self.geom, self.bounds,
+                    self.g, self.gbuf, self.gv, self.ga, self.gvn, self.gtmp, self.damping,
+                    self.mass_tol, self.vmax, self.left, self.leave_max,
+                    c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
+                    c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
+                    c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
+                    self.sym_dir, self.bad, self.nch)
         finally:
             numba.set_num_threads(threads)
         self.step += int(done)
         self.time += int(done) * self.dt
+        if status == 4:
+            cs = self.cracks.cracks
+            raise SimulationUnstable(
+                f"{STATUS_TEXT[4]} crack {int(cs.crack[bad]) + 1}, crack particle {bad} at "
+                f"x = {cs.plane[0, bad]:.6g} mm, y = {cs.plane[1, bad]:.6g} mm",
+                self.step, self.time)
         if status != 0:
             name = self.material_names[p.mat[bad]] if self.material_names else p.mat[bad]
             where = (f"particle {bad} (material '{name}') at x = {p.pos[0, bad]:.6g} mm, "

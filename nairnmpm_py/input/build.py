@@ -15,7 +15,8 @@ from ..core.conditions import GRID_VELOCITY, PARTICLE_LOAD, ConditionRecord, Con
 from ..core.grid import Grid
 from ..core.particles import Particles
 from ..core.shape import LINEAR, UGIMP
-from ..cracks.geometry import polyline_problems
+from ..cracks.geometry import CrackSet, polyline_problems
+from ..cracks.scene import CrackScene, Tip
 from ..core.simulation import GlobalQuantity, Simulation
 from .models import AxisModel, BodyModel, ConditionModel, InputModel, ShapeModel
 from .reader import read_input
@@ -48,6 +49,7 @@ def build_simulation(model: InputModel) -> Simulation:
     r.check()
     conditions = _conditions(r, model, grid, particles)
     quantities = _global_quantities(r, model, names)
+    cracks = _crack_scene(r, model, materials, names)
     r.check()
     h = model.mpm
     return Simulation(
@@ -60,7 +62,7 @@ def build_simulation(model: InputModel) -> Simulation:
         global_archive_time=h.global_archive_time_ms,
         damping=h.damping_per_s * PER_S_TO_PER_MS, global_quantities=quantities,
         title=model.title, source={"path": model.path, "sha256": model.sha256, "text": model.text},
-        material_names=names)
+        material_names=names, cracks=cracks)
 
 
 # ---- grid -----------------------------------------------------------------------
@@ -106,9 +108,60 @@ def _check_cracks(r: Reader, model: InputModel, grid: Grid) -> None:
         pts = np.array([(p.x, p.y) for p in crack.points])
         for msg in polyline_problems(pts, (grid.xmin, grid.xmax), (grid.ymin, grid.ymax), cell):
             r.problem(_at(crack.line), f"<CrackList>: {msg}")
-        if not r.problems:
-            r.problem(_at(crack.line), "<CrackList>: the engine does not run explicit cracks "
-                                       "yet (the input is read and checked)")
+
+
+def _crack_material(r: Reader, model: InputModel, names: list, number, name, where,
+                    group: str, what: str):
+    """0-based index of the material a crack names by number or name, checked to be
+    of the expected plugin group; None when none is named or it is wrong."""
+    if number is None and name is None:
+        return None
+    if name is not None:
+        if name not in names:
+            r.problem(_at(where), f"{what}: no material named '{name}'")
+            return None
+        idx = names.index(name)
+    else:
+        if not 1 <= number <= len(model.materials):
+            r.problem(_at(where), f"{what}: material {number} does not exist "
+                                  f"({len(model.materials)} defined)")
+            return None
+        idx = number - 1
+    if model.materials[idx].group != group:
+        kind = "a traction law" if group == "traction_laws" else "a solid material"
+        r.problem(_at(where), f"{what}: material {idx + 1} ('{names[idx]}') is not {kind}")
+        return None
+    return idx
+
+
+def _crack_scene(r: Reader, model: InputModel, materials: list, names: list):
+    """The scene's cracks (None without any): crack particles, their traction laws
+    and the tips that get J."""
+    if not model.cracks:
+        return None
+    polylines, laws, tips, fixed, tip_list, used = [], [], [], [], [], {}
+    for c, crack in enumerate(model.cracks):
+        polylines.append(np.array([(p.x, p.y) for p in crack.points]))
+        law_of = []
+        for p in crack.points:
+            idx = _crack_material(r, model, names, p.law, p.lawname, p.line or crack.line,
+                                  "traction_laws", "crack mat")
+            law_of.append(-1 if idx is None else idx)
+            if idx is not None:
+                used[idx] = materials[idx]
+        laws.append(np.array(law_of, dtype=np.int64))
+        ends = (crack.points[0].tip, crack.points[-1].tip)
+        tips.append(ends)
+        fixed.append(crack.fixed)
+        for end, code, p in (("start", ends[0], crack.points[0]), ("end", ends[1], crack.points[-1])):
+            if code > 0:
+                idx = _crack_material(r, model, names, code, None, p.line or crack.line,
+                                      "materials", "crack tip material")
+                tip_list.append(Tip(c, end, -1 if idx is None else idx))
+    h = model.mpm.cracks
+    return CrackScene(CrackSet.from_polylines(polylines, laws, tips, fixed), used, tip_list,
+                      jcontour_size=h.jcontour_size if h else 2,
+                      contact_position=h.contact_position if h else None)
 
 
 # ---- particles ----------------------------------------------------------------------

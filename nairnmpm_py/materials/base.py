@@ -53,5 +53,10 @@ class MaterialPlugin:
     def param_vector(self, plane_stress: bool) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
+    def shear_and_poisson(self) -> tuple[float, float] | None:
+        """Low-strain shear modulus (MPa) and Poisson's ratio, for K from J; None when
+        the material has no such constants (K is then not reported)."""
+        return None
+
     def initial_history(self, n: int) -> np.ndarray:
         return np.zeros((self.n_history, n))

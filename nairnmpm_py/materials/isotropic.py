@@ -53,6 +53,10 @@ class Isotropic(MaterialPlugin):
         lam = p.E * p.nu / ((1 + p.nu) * (1 - 2 * p.nu))
         return math.sqrt((lam + 2 * g) / self.rho)  # mm/ms: MPa / (g/mm^3)
 
+    def shear_and_poisson(self) -> tuple[float, float]:
+        p = self.params
+        return p.E / (2 * (1 + p.nu)), p.nu
+
     def param_vector(self, plane_stress: bool) -> np.ndarray:
         p = self.params
         g = p.E / (2 * (1 + p.nu))

@@ -64,6 +64,10 @@ class Neohookean(MaterialPlugin):
         g, lam = self.params.moduli()
         return math.sqrt((lam + 2 * g) / self.rho)
 
+    def shear_and_poisson(self) -> tuple[float, float]:
+        g, lam = self.params.moduli()
+        return g, lam / (2 * (lam + g))
+
     def param_vector(self, plane_stress: bool) -> np.ndarray:
         g, lam = self.params.moduli()
         return np.array([g, lam, float(self.params.UJOption)])

@@ -9,6 +9,10 @@ Layout::
                        datasets pos vel stress F w mat mass vol0 pos0 lp hist pdamp,
                        component first like the engine's arrays ((2, n), (4, n), ...)
 
+    /archives/NNNNNN/cracks   in scenes with cracks: plane above below (2, nc) mm,
+                       crack law traction_state (nc,), traction_history (2, nc) mm
+                       (maximum normal and tangential opening reached)
+
 lp, hist and pdamp are not needed for plotting but are stored so an archive holds the
 whole particle state (enough to restart).
 """
@@ -72,6 +76,16 @@ class ArchiveH5(OutputPlugin):
         for field in FLOAT_FIELDS:
             grp.create_dataset(field, data=np.asarray(getattr(p, field), dtype=np.float64))
         grp.create_dataset("mat", data=np.asarray(p.mat, dtype=np.int32))
+        scene = getattr(sim, "cracks", None)
+        if scene is not None:
+            cg = grp.create_group("cracks")
+            cs = scene.cracks
+            for name in ("plane", "above", "below"):
+                cg.create_dataset(name, data=np.asarray(getattr(cs, name), dtype=np.float64))
+            cg.create_dataset("crack", data=np.asarray(cs.crack, dtype=np.int32))
+            cg.create_dataset("law", data=np.asarray(cs.law, dtype=np.int32))
+            cg.create_dataset("traction_state", data=np.asarray(scene.state, dtype=np.int8))
+            cg.create_dataset("traction_history", data=np.asarray(scene.hist, dtype=np.float64))
         # after a flush the file on disk is consistent, so a killed run stays readable
         self._h5.flush()
 

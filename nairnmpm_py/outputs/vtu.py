@@ -1,4 +1,5 @@
-"""VTU particle files per archive and the ParaView collection ``particles.pvd``."""
+"""VTU files per archive and their ParaView collections: particles (``particles.pvd``)
+and, in scenes with cracks, the crack polylines (``cracks.pvd``)."""
 from __future__ import annotations
 
 import os
@@ -47,16 +48,42 @@ def particle_mesh(particles) -> meshio.Mesh:
     return meshio.Mesh(points, cells, point_data=point_data)
 
 
+def crack_mesh(scene) -> meshio.Mesh:
+    """Crack planes as VTK polylines (one line cell per chord) with, per crack particle,
+    the above and below surface positions, the normal and tangential opening, the
+    traction history and state (0 no law, 1 carrying traction, 2 failed)."""
+    cs = scene.cracks
+    n = cs.plane.shape[1]
+    zeros = np.zeros(n)
+    points = np.column_stack((cs.plane[0], cs.plane[1], zeros))
+    chords = [(k, k + 1) for c in range(cs.n_cracks)
+              for k in range(cs.first[c], cs.first[c] + cs.count[c] - 1)]
+    dn, dt = cs.cod()
+    point_data = {
+        "above": np.column_stack((cs.above[0], cs.above[1], zeros)),
+        "below": np.column_stack((cs.below[0], cs.below[1], zeros)),
+        "cod_normal": np.ascontiguousarray(dn), "cod_tangential": np.ascontiguousarray(dt),
+        "max_cod_normal": np.ascontiguousarray(scene.hist[0]),
+        "traction_state": np.asarray(scene.state, dtype=np.int32),
+        "traction_law": np.asarray(cs.law, dtype=np.int32),
+        "crack": np.asarray(cs.crack, dtype=np.int32),
+    }
+    cells = [("line", np.array(chords, dtype=np.int64).reshape(-1, 2))]
+    return meshio.Mesh(points, cells, point_data=point_data)
+
+
 class VtuSeries(OutputPlugin):
     name = "vtu"
 
     def __init__(self, folder: Path):
         super().__init__(folder)
         self.entries: list[tuple[float, str]] = []
+        self.crack_entries: list[tuple[float, str]] = []
 
     def begin(self, sim) -> None:
         (self.folder / "vtu").mkdir(exist_ok=True)
         self.entries = []
+        self.crack_entries = []
 
     def on_archive(self, sim) -> None:
         rel = f"vtu/particles_{int(sim.step):06d}.vtu"
@@ -67,3 +94,10 @@ class VtuSeries(OutputPlugin):
         self.entries = [e for e in self.entries if e[1] != rel] + [(float(sim.time), rel)]
         # rewritten every archive so the collection is valid whenever the run stops
         write_pvd(self.folder / "particles.pvd", self.entries)
+        if getattr(sim, "cracks", None) is not None:
+            rel = f"vtu/cracks_{int(sim.step):06d}.vtu"
+            meshio.write(self.folder / rel, crack_mesh(sim.cracks), file_format="vtu",
+                         binary=True, compression=None)
+            self.crack_entries = ([e for e in self.crack_entries if e[1] != rel]
+                                  + [(float(sim.time), rel)])
+            write_pvd(self.folder / "cracks.pvd", self.crack_entries)

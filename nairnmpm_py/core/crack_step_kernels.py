@@ -1,0 +1,953 @@
+"""The explicit MPM time step for scenes with cracks (CRAMP), as Numba kernels.
+
+A template like ``step_kernels``: ``kernel_build`` writes a copy whose base import
+names the scene's generated step module (its materials and shape functions) and
+whose traction import is a dispatcher over the scene's traction-law envelopes.
+Scenes without cracks never load it, so they keep the fused no-crack step.
+
+What a crack adds to the step (shared notes CRAMP.md, JINTEGRAL.md section 7):
+
+* every node has ``NF`` velocity fields: 0 = particles on the node's side of every
+  crack, 1 = across the crack in the node's slot 0, 2 = across the crack in slot 1,
+  3 = across both (``NF`` is 2 when the scene has one crack).  A node's slots are the
+  two lowest-numbered cracks with a chord near it, so field choice is the same on
+  every thread.  Each particle's field at each of its nodes (``vfld``) is found
+  once per step by the CRAMP line-crossing test and reused by every pass;
+* each field carries mass, momentum, force and the mass-weighted particle
+  displacement (for contact), and the two slot rows of fields 1 and 2 carry the
+  crack normal and the side of the crossing particles;
+* frictionless contact between the fields of a node after extrapolation and after
+  the momentum update (approaching and overlapping only);
+* traction-law crack particles pull their two surfaces together with
+  -A (T_n n + T_t t); the framework keeps the history (maximum COD per mode),
+  unloads to the origin and fails the particle at delta_c;
+* crack surfaces move with the field on their side (mean of old and new grid
+  velocity, as particles move), the crack plane with the mean of its two surfaces;
+  then the crack lists per cell are rebuilt for the next particle pass.
+
+Grid damping, particle damping, boundary conditions and symmetry planes act on every
+field as on the single field of a scene without cracks.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, _stress_update, _store_weights  # KERNEL-BASE
+from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
+from nairnmpm_py.cracks.crossing import segment_crossing_side
+from nairnmpm_py.cracks.fields import _chord, cell_segments
+
+STATUS_CRACK_LEFT_GRID = 4
+
+# rows of one velocity field
+GM, GPX, GPY, GFX, GFY, GUX, GUY, GNX, GNY, GSD = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+NR = 10
+NUDGE = 1e-4  # cells: a crack surface is tested from just off the plane, on its side
+
+# counters (``ccount``): pairs whose crack is not in the node's slots, surfaces with
+# no field on either side, failed traction particles, blocked crack moves
+C_CONFLICT, C_LOST, C_FAILED, C_BLOCKED = 0, 1, 2, 3
+
+
+# ---- field choice -------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _pair_field(x, y, xn, yn, node, cell, cstart, chords, cpx, cpy, cfirst, clast, cext0,
+                cext1, ccrack, nslot, nf):
+    """Velocity field of the particle (x, y) at a node (xn, yn): 1 bit per slot whose
+    crack the particle-node line crosses an odd number of times.  Also returns, per
+    slot, the last crossed chord (-1 none) and the particle's side (+1 above), and 1
+    if a crack outside the node's slots was crossed (that crossing is ignored)."""
+    par0 = 0
+    par1 = 0
+    k0 = -1
+    k1 = -1
+    s0 = 0
+    s1 = 0
+    bad = 0
+    for q in range(cstart[cell], cstart[cell + 1]):
+        k = chords[q]
+        x3, y3, x4, y4 = _chord(k, cpx, cpy, cfirst, clast, cext0, cext1, ccrack)
+        hit = segment_crossing_side(x, y, xn, yn, x3, y3, x4, y4)
+        if hit == 0:
+            continue
+        c = ccrack[k]
+        if nslot[0, node] == c:
+            par0 ^= 1
+            k0 = k
+            s0 = hit
+        elif nf == 4 and nslot[1, node] == c:
+            par1 ^= 1
+            k1 = k
+            s1 = hit
+        else:
+            bad = 1
+    return par0 + 2 * par1, (k0 if par0 else -1), s0, (k1 if par1 else -1), s1, bad
+
+
+@njit(cache=True, inline="always")
+def _cell_of(x, y, geom, ncx, ncy):
+    ci = min(max(int(math.floor((x - geom[0]) / geom[2])), 0), ncx - 1)
+    cj = min(max(int(math.floor((y - geom[1]) / geom[3])), 0), ncy - 1)
+    return cj * ncx + ci
+
+
+@njit(cache=True)
+def node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot):
+    """The two lowest-numbered cracks with a chord listed in a cell next to each node."""
+    nn = nslot.shape[1]
+    for k in range(nn):
+        i = k % nnx
+        j = k // nnx
+        a = -1
+        b = -1
+        for cj in range(j - 1, j + 1):
+            if cj < 0 or cj >= ncy:
+                continue
+            for ci in range(i - 1, i + 1):
+                if ci < 0 or ci >= ncx:
+                    continue
+                cell = cj * ncx + ci
+                for q in range(cstart[cell], cstart[cell + 1]):
+                    c = ccrack[chords[q]]
+                    if c == a or c == b:
+                        continue
+                    if a < 0 or c < a:
+                        b = a
+                        a = c
+                    elif b < 0 or c < b:
+                        b = c
+        nslot[0, k] = a
+        nslot[1, k] = b
+
+
+# ---- particles -> grid ----------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, ncx, ncy,
+                      cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                      nf, use_position, conflicts):
+    """Field choice at each node of particle p, then its mass, momentum, displacement
+    (or position) and, for crossed pairs, the crack normal and side onto the grid."""
+    r = wc[p]
+    i0 = wij[p, 0]
+    j0 = wij[p, 1]
+    m = mass[p]
+    x = pos[0, p]
+    y = pos[1, p]
+    mvx = m * vel[0, p]
+    mvy = m * vel[1, p]
+    if use_position:
+        mux = m * x
+        muy = m * y
+    else:
+        mux = m * (x - pos0[0, p])
+        muy = m * (y - pos0[1, p])
+    cell = _cell_of(x, y, geom, ncx, ncy)
+    near = cstart[cell + 1] > cstart[cell]
+    for b in range(NA):
+        sy = r[3 + b]
+        row = (j0 + b) * nnx + i0
+        for a in range(NA):
+            s = sy * r[a]
+            k = row + a
+            f = 0
+            if near:
+                xn = geom[0] + (i0 + a) * geom[2]
+                yn = geom[1] + (j0 + b) * geom[3]
+                f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords,
+                                                     cpx, cpy, cfirst, clast, cext0, cext1,
+                                                     ccrack, nslot, nf)
+                conflicts += bad
+                w = s * m
+                if k0 >= 0:
+                    ex = cpx[k0 + 1] - cpx[k0]
+                    ey = cpy[k0 + 1] - cpy[k0]
+                    el = math.sqrt(ex * ex + ey * ey)
+                    buf[1, GNX, k] += w * ey / el   # (dy, -dx): toward the below side
+                    buf[1, GNY, k] -= w * ex / el
+                    buf[1, GSD, k] += w * s0
+                if k1 >= 0:
+                    ex = cpx[k1 + 1] - cpx[k1]
+                    ey = cpy[k1 + 1] - cpy[k1]
+                    el = math.sqrt(ex * ex + ey * ey)
+                    buf[2, GNX, k] += w * ey / el
+                    buf[2, GNY, k] -= w * ex / el
+                    buf[2, GSD, k] += w * s1
+            vfld[p, b * NA + a] = f
+            fb = buf[f]
+            fb[GM, k] += s * m
+            fb[GPX, k] += s * mvx
+            fb[GPY, k] += s * mvy
+            fb[GUX, k] += s * mux
+            fb[GUY, k] += s * muy
+    return conflicts
+
+
+@njit(cache=True, inline="always")
+def _clear_extrapolation_rows(buf):
+    for f in range(buf.shape[0]):
+        for row in (GM, GPX, GPY, GUX, GUY, GNX, GNY, GSD):
+            buf[f, row] = 0.0
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, ncx, ncy,
+                     cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                     nf, use_position, counts):
+    n = pos.shape[1]
+    nnx = int(geom[4])
+    idx = 1.0 / geom[2]
+    idy = 1.0 / geom[3]
+    for c in prange(nch):
+        buf = gbuf[c]
+        _clear_extrapolation_rows(buf)
+        lo = c * n // nch
+        hi = (c + 1) * n // nch
+        conflicts = 0
+        for p in range(lo, hi):
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
+                                          nnx, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
+                                          clast, cext0, cext1, ccrack, nslot, nf,
+                                          use_position, conflicts)
+        counts[c] = conflicts
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def reduce_extrapolation(gbuf, g, gv, nch):
+    """Sum the chunks' extrapolated rows; velocities of every field."""
+    nf = g.shape[0]
+    nn = g.shape[2]
+    for k in prange(nn):
+        for f in range(nf):
+            for row in (GM, GPX, GPY, GUX, GUY, GNX, GNY, GSD):
+                s = 0.0
+                for c in range(nch):
+                    s += gbuf[c, f, row, k]
+                g[f, row, k] = s
+            m = g[f, GM, k]
+            if m > 0.0:
+                gv[f, 0, k] = g[f, GPX, k] / m
+                gv[f, 1, k] = g[f, GPY, k] / m
+            else:
+                gv[f, 0, k] = 0.0
+                gv[f, 1, k] = 0.0
+
+
+# ---- contact --------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _contact_pair(g, k, fa, fb, nx, ny, dt, after_update, use_position, cutoff):
+    """Frictionless contact of field fa (above) and fb (below) at node k; n points from
+    above to below.  Before the update it corrects momenta, after it the forces (so
+    the updated momenta change by the same amount)."""
+    ma = g[fa, GM, k]
+    mb = g[fb, GM, k]
+    if ma <= 0.0 or mb <= 0.0:
+        return
+    pax = g[fa, GPX, k]
+    pay = g[fa, GPY, k]
+    pbx = g[fb, GPX, k]
+    pby = g[fb, GPY, k]
+    if after_update:
+        pax += g[fa, GFX, k] * dt
+        pay += g[fa, GFY, k] * dt
+        pbx += g[fb, GFX, k] * dt
+        pby += g[fb, GFY, k] * dt
+    msum = ma + mb
+    dpx = (ma * pbx - mb * pax) / msum
+    dpy = (ma * pby - mb * pay) / msum
+    dpn = dpx * nx + dpy * ny
+    if dpn >= 0.0:
+        return  # separating
+    sep = ((g[fb, GUX, k] / mb - g[fa, GUX, k] / ma) * nx
+           + (g[fb, GUY, k] / mb - g[fa, GUY, k] / ma) * ny)
+    if use_position:
+        sep -= cutoff
+    if after_update:
+        sep += dt * dpn * msum / (ma * mb)
+    if sep >= 0.0:
+        return  # not touching
+    cx = dpn * nx
+    cy = dpn * ny
+    if after_update:
+        g[fa, GFX, k] += cx / dt
+        g[fa, GFY, k] += cy / dt
+        g[fb, GFX, k] -= cx / dt
+        g[fb, GFY, k] -= cy / dt
+    else:
+        g[fa, GPX, k] += cx
+        g[fa, GPY, k] += cy
+        g[fb, GPX, k] -= cx
+        g[fb, GPY, k] -= cy
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def contact(g, gv, nslot, dt, after_update, use_position, cutoff_cells, geom):
+    """Contact across each slot's crack: fields (0, 1) and (2, 3) across slot 0,
+    (0, 2) and (1, 3) across slot 1.  The slot's accumulated side says which field is
+    above; its accumulated normal is the contact normal."""
+    nf = g.shape[0]
+    nn = g.shape[2]
+    for k in prange(nn):
+        touched = False
+        for s in range(2):
+            if nslot[s, k] < 0 or (s == 1 and nf < 4):
+                continue
+            acc = 1 + s
+            nx = g[acc, GNX, k]
+            ny = g[acc, GNY, k]
+            ln = math.sqrt(nx * nx + ny * ny)
+            if ln == 0.0:
+                continue
+            nx /= ln
+            ny /= ln
+            cutoff = cutoff_cells * (abs(nx) * geom[2] + abs(ny) * geom[3])
+            bit = 1 << s
+            crossed_above = g[acc, GSD, k] > 0.0
+            for base in range(2):
+                lo = 0 if base == 0 else (1 << (1 - s))
+                if lo >= nf:
+                    continue
+                hi = lo | bit
+                if crossed_above:
+                    _contact_pair(g, k, hi, lo, nx, ny, dt, after_update, use_position, cutoff)
+                else:
+                    _contact_pair(g, k, lo, hi, nx, ny, dt, after_update, use_position, cutoff)
+                touched = True
+        if touched and not after_update:
+            for f in range(nf):
+                m = g[f, GM, k]
+                if m > 0.0:
+                    gv[f, 0, k] = g[f, GPX, k] / m
+                    gv[f, 1, k] = g[f, GPY, k] / m
+
+
+# ---- conditions on every field ----------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+                        rec_ftime, sym_out, sym_in, sym_dir, t):
+    nf = g.shape[0]
+    for q in range(gbc_node.size):
+        r = gbc_rec[q]
+        if bc_active(rec_style[r], rec_t0[r], t):
+            for f in range(nf):
+                g[f, GPX + gbc_dir[q], gbc_node[q]] = 0.0
+    for q in range(gbc_node.size):
+        r = gbc_rec[q]
+        if bc_active(rec_style[r], rec_t0[r], t):
+            k = gbc_node[q]
+            v = bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
+                         node_x(k, geom), node_y(k, geom), 0.0)
+            for f in range(nf):
+                g[f, GPX + gbc_dir[q], k] += g[f, GM, k] * v
+    for q in range(sym_out.size):
+        ko = sym_out[q]
+        ki = sym_in[q]
+        d = sym_dir[q]
+        for f in range(nf):
+            fi = f if g[f, GM, ki] > 0.0 else 0
+            if g[fi, GM, ki] > 0.0:
+                g[f, GPX + d, ko] = -g[f, GM, ko] * g[fi, GPX + d, ki] / g[fi, GM, ki]
+            else:
+                g[f, GPX + d, ko] = 0.0
+    for q in range(gbc_node.size):
+        k = gbc_node[q]
+        for f in range(nf):
+            m = g[f, GM, k]
+            gv[f, 0, k] = g[f, GPX, k] / m if m > 0.0 else 0.0
+            gv[f, 1, k] = g[f, GPY, k] / m if m > 0.0 else 0.0
+    for q in range(sym_out.size):
+        k = sym_out[q]
+        for f in range(nf):
+            m = g[f, GM, k]
+            gv[f, 0, k] = g[f, GPX, k] / m if m > 0.0 else 0.0
+            gv[f, 1, k] = g[f, GPY, k] / m if m > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
+                              rec_value, rec_t0, rec_ftime, rec_force, rec_work,
+                              sym_out, sym_in, sym_dir, t, dt):
+    """v(t+dt) on conditioned nodes in every field; the summed change of force is the
+    reaction."""
+    nf = g.shape[0]
+    for q in range(gbc_node.size):
+        r = gbc_rec[q]
+        if bc_active(rec_style[r], rec_t0[r], t):
+            gtmp[gbc_dir[q], gbc_node[q]] = 0.0
+    for q in range(gbc_node.size):
+        r = gbc_rec[q]
+        if bc_active(rec_style[r], rec_t0[r], t):
+            k = gbc_node[q]
+            gtmp[gbc_dir[q], k] += bc_value(r, rec_style[r], rec_value[r], rec_t0[r],
+                                            rec_ftime[r], t + dt, node_x(k, geom),
+                                            node_y(k, geom), 0.0)
+    for q in range(gbc_node.size):
+        r = gbc_rec[q]
+        if not bc_active(rec_style[r], rec_t0[r], t):
+            continue
+        k = gbc_node[q]
+        d = gbc_dir[q]
+        v_new = gtmp[d, k]
+        for f in range(nf):
+            m = g[f, GM, k]
+            if m <= 0.0:
+                continue
+            v_old = g[f, GPX + d, k] / m
+            f_needed = m * (v_new - v_old) / dt
+            reaction = f_needed - g[f, GFX + d, k]
+            g[f, GFX + d, k] = f_needed
+            ga[f, d, k] = f_needed / m
+            gvn[f, d, k] = v_new
+            rec_force[r] += reaction
+            rec_work[r] += reaction * 0.5 * (v_old + v_new) * dt
+    for q in range(sym_out.size):
+        ko = sym_out[q]
+        ki = sym_in[q]
+        d = sym_dir[q]
+        for f in range(nf):
+            m = g[f, GM, ko]
+            if m > 0.0:
+                fi = f if g[f, GM, ki] > 0.0 else 0
+                v_new = -gvn[fi, d, ki]
+                v_old = g[f, GPX + d, ko] / m
+                gvn[f, d, ko] = v_new
+                ga[f, d, ko] = (v_new - v_old) / dt
+
+
+# ---- forces ------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy")
+def scatter_loads(pos, F, geom, g, wij, wc, vfld, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+                  rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
+    nnx = int(geom[4])
+    for q in range(pbc_part.size):
+        r = pbc_rec[q]
+        p = pbc_part[q]
+        f = pbc_scale[q] * bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
+                                    pos[0, p], pos[1, p], particle_rotation(F, p))
+        pload[q] = f
+        rec_force[r] += f
+        row_c = GFX + pbc_dir[q]
+        w = wc[p]
+        for b in range(NA):
+            row = (wij[p, 1] + b) * nnx + wij[p, 0]
+            for a in range(NA):
+                g[vfld[p, b * NA + a], row_c, row + a] += w[3 + b] * w[a] * f
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, geom, wij, wc,
+                 vfld, gv, gbuf, nch, dt_pre, dt_stress, scatter, n):
+    """Stress update from each particle's own fields' velocities, internal forces into
+    the same fields."""
+    nnx = int(geom[4])
+    nf = gbuf.shape[1]
+    for c in prange(nch):
+        buf = gbuf[c]
+        if scatter:
+            for f in range(nf):
+                buf[f, GFX] = 0.0
+                buf[f, GFY] = 0.0
+        lo = c * n // nch
+        hi = (c + 1) * n // nch
+        for p in range(lo, hi):
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            if dt_stress > 0.0 or dt_pre > 0.0:
+                L00 = 0.0
+                L01 = 0.0
+                L10 = 0.0
+                L11 = 0.0
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        f = vfld[p, b * NA + a]
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        L00 += gv[f, 0, k] * gx
+                        L01 += gv[f, 0, k] * gy
+                        L10 += gv[f, 1, k] * gx
+                        L11 += gv[f, 1, k] * gy
+                if dt_pre > 0.0:
+                    _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
+                                   mat_params, plane_stress)
+                if dt_stress > 0.0:
+                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
+                                   mat_params, plane_stress)
+            if not scatter:
+                continue
+            vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
+            sxx = stress[0, p] * vol
+            syy = stress[1, p] * vol
+            sxy = stress[2, p] * vol
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    f = vfld[p, b * NA + a]
+                    gx = r[6 + a] * sy
+                    gy = r[a] * dy
+                    buf[f, GFX, k] -= sxx * gx + sxy * gy
+                    buf[f, GFY, k] -= sxy * gx + syy * gy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def reduce_forces(gbuf, g, nch):
+    nf = g.shape[0]
+    nn = g.shape[2]
+    for k in prange(nn):
+        for f in range(nf):
+            fx = 0.0
+            fy = 0.0
+            for c in range(nch):
+                fx += gbuf[c, f, GFX, k]
+                fy += gbuf[c, f, GFY, k]
+            g[f, GFX, k] += fx
+            g[f, GFY, k] += fy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def accelerations(g, ga, gvn, dt):
+    nf = g.shape[0]
+    nn = g.shape[2]
+    for k in prange(nn):
+        for f in range(nf):
+            m = g[f, GM, k]
+            if m > 0.0:
+                ga[f, 0, k] = g[f, GFX, k] / m
+                ga[f, 1, k] = g[f, GFY, k] / m
+                gvn[f, 0, k] = (g[f, GPX, k] + g[f, GFX, k] * dt) / m
+                gvn[f, 1, k] = (g[f, GPY, k] + g[f, GFY, k] * dt) / m
+            else:
+                ga[f, 0, k] = 0.0
+                ga[f, 1, k] = 0.0
+                gvn[f, 0, k] = 0.0
+                gvn[f, 1, k] = 0.0
+
+
+# ---- crack particles ------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def crack_frame(k, cpx, cpy, ccrack, cfirst, clast):
+    """Unit tangent (first -> last), unit normal toward the above side, and the chord
+    length this particle represents (half of each adjacent chord)."""
+    c = ccrack[k]
+    kp = k - 1 if k > cfirst[c] else k
+    kn = k + 1 if k < clast[c] else k
+    tx = cpx[kn] - cpx[kp]
+    ty = cpy[kn] - cpy[kp]
+    tl = math.sqrt(tx * tx + ty * ty)
+    tx /= tl
+    ty /= tl
+    return tx, ty, -ty, tx, 0.5 * tl
+
+
+@njit(cache=True, inline="always")
+def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
+                   clast, cext0, cext1, ccrack, nslot, nf, nodes, fields, weights, g):
+    """Classic linear shape functions at a crack surface point and the field on the
+    surface's side at each of the four nodes; weights are S * m of that field (0 when
+    the field is empty).  Returns the sum of the weights."""
+    nnx = int(geom[4])
+    xi = (sx - geom[0]) / geom[2]
+    eta = (sy - geom[1]) / geom[3]
+    i0 = int(math.floor(xi))
+    j0 = int(math.floor(eta))
+    rx = xi - i0
+    ry = eta - j0
+    # test from just off the plane on the surface's own side
+    tx_ = sx + sgn * NUDGE * geom[2] * ux
+    ty_ = sy + sgn * NUDGE * geom[3] * uy
+    cell = _cell_of(tx_, ty_, geom, ncx, ncy)
+    total = 0.0
+    q = 0
+    for b in range(2):
+        for a in range(2):
+            s = (rx if a == 1 else 1.0 - rx) * (ry if b == 1 else 1.0 - ry)
+            node = (j0 + b) * nnx + i0 + a
+            nodes[q] = node
+            fields[q] = 0
+            weights[q] = 0.0
+            if s > 0.0:
+                xn = geom[0] + (i0 + a) * geom[2]
+                yn = geom[1] + (j0 + b) * geom[3]
+                f, k0, s0, k1, s1, bad = _pair_field(tx_, ty_, xn, yn, node, cell, cstart,
+                                                     chords, cpx, cpy, cfirst, clast, cext0,
+                                                     cext1, ccrack, nslot, nf)
+                fields[q] = f
+                weights[q] = s * g[f, GM, node]
+                total += weights[q]
+            q += 1
+    return total
+
+
+@njit(cache=True, error_model="numpy")
+def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0, cext1,
+                    ccrack, nslot, claw, cstate, chist, law1, law2, thickness, counts):
+    """Traction forces of the law particles on both surfaces' fields (the force is
+    shared by S * m, all of it delivered), with history, unloading to the origin and
+    failure at delta_c per mode."""
+    nf = g.shape[0]
+    nodes = np.empty(4, dtype=np.int64)
+    fields = np.empty(4, dtype=np.int64)
+    weights = np.empty(4)
+    cpx = cp[0]
+    cpy = cp[1]
+    for k in range(cp.shape[1]):
+        law = claw[k]
+        if law < 0 or cstate[k] != 1:
+            continue
+        tx, ty, ux, uy, half = crack_frame(k, cpx, cpy, ccrack, cfirst, clast)
+        ddx = ca[0, k] - cb[0, k]
+        ddy = ca[1, k] - cb[1, k]
+        dn = ddx * ux + ddy * uy
+        dt_ = ddx * tx + ddy * ty
+        tn = 0.0
+        tt = 0.0
+        failed = False
+        if law1[law, 0] >= 0.0 and dn > 0.0:
+            par = law1[law, 1:]
+            h = max(chist[0, k], dn)
+            chist[0, k] = h
+            if h >= par[0]:
+                failed = True
+            else:
+                tn = traction_envelope(int(law1[law, 0]), h, par) / h * dn
+        if law2[law, 0] >= 0.0 and dt_ != 0.0:
+            par = law2[law, 1:]
+            a = abs(dt_)
+            h = max(chist[1, k], a)
+            chist[1, k] = h
+            if h >= par[0]:
+                failed = True
+            else:
+                tt = traction_envelope(int(law2[law, 0]), h, par) / h * dt_
+        if failed:
+            cstate[k] = 2
+            counts[C_FAILED] += 1
+            continue
+        area = half * thickness
+        fx = -area * (tn * ux + tt * tx)
+        fy = -area * (tn * uy + tt * ty)
+        if fx == 0.0 and fy == 0.0:
+            continue
+        for side in range(2):
+            sgn = 1.0 if side == 0 else -1.0
+            sx = ca[0, k] if side == 0 else cb[0, k]
+            sy = ca[1, k] if side == 0 else cb[1, k]
+            total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
+                                   cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
+                                   nodes, fields, weights, g)
+            if total <= 0.0:
+                continue
+            for q in range(4):
+                if weights[q] > 0.0:
+                    share = sgn * weights[q] / total
+                    g[fields[q], GFX, nodes[q]] += share * fx
+                    g[fields[q], GFY, nodes[q]] += share * fy
+
+
+@njit(cache=True, error_model="numpy")
+def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
+                cext1, ccrack, cfixed, nslot, dt, bounds, counts):
+    """Each surface moves with the mean of the old and new velocity of the field on its
+    side (mass-weighted, classic shape functions); a side that finds no field copies
+    the other; the plane moves with the mean of the two surfaces.  All moves use the
+    positions before the step.  Returns a crack particle that left the grid, or -1."""
+    nf = g.shape[0]
+    nc = cp.shape[1]
+    nodes = np.empty(4, dtype=np.int64)
+    fields = np.empty(4, dtype=np.int64)
+    weights = np.empty(4)
+    moves = np.zeros((nc, 2, 2))
+    found = np.zeros((nc, 2), dtype=np.bool_)
+    limit = 0.5 * min(geom[2], geom[3])
+    cpx = cp[0]
+    cpy = cp[1]
+    for k in range(nc):
+        if cfixed[ccrack[k]]:
+            continue
+        tx, ty, ux, uy, half = crack_frame(k, cpx, cpy, ccrack, cfirst, clast)
+        for side in range(2):
+            sgn = 1.0 if side == 0 else -1.0
+            sx = ca[0, k] if side == 0 else cb[0, k]
+            sy = ca[1, k] if side == 0 else cb[1, k]
+            total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
+                                   cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
+                                   nodes, fields, weights, g)
+            if total <= 0.0:
+                continue
+            vx = 0.0
+            vy = 0.0
+            for q in range(4):
+                wq = weights[q]
+                if wq > 0.0:
+                    f = fields[q]
+                    node = nodes[q]
+                    vx += wq * (gvn[f, 0, node] - 0.5 * ga[f, 0, node] * dt)
+                    vy += wq * (gvn[f, 1, node] - 0.5 * ga[f, 1, node] * dt)
+            mx = vx / total * dt
+            my = vy / total * dt
+            if abs(mx) > limit or abs(my) > limit:
+                counts[C_BLOCKED] += 1
+                mx = 0.0
+                my = 0.0
+            moves[k, side, 0] = mx
+            moves[k, side, 1] = my
+            found[k, side] = True
+    out = -1
+    for k in range(nc):
+        if cfixed[ccrack[k]]:
+            continue
+        if not found[k, 0] and not found[k, 1]:
+            counts[C_LOST] += 1
+            continue
+        if not found[k, 0]:
+            moves[k, 0, 0] = moves[k, 1, 0]
+            moves[k, 0, 1] = moves[k, 1, 1]
+        if not found[k, 1]:
+            moves[k, 1, 0] = moves[k, 0, 0]
+            moves[k, 1, 1] = moves[k, 0, 1]
+        ca[0, k] += moves[k, 0, 0]
+        ca[1, k] += moves[k, 0, 1]
+        cb[0, k] += moves[k, 1, 0]
+        cb[1, k] += moves[k, 1, 1]
+        cp[0, k] += 0.5 * (moves[k, 0, 0] + moves[k, 1, 0])
+        cp[1, k] += 0.5 * (moves[k, 0, 1] + moves[k, 1, 1])
+        if not (bounds[0] <= cp[0, k] < bounds[1] and bounds[2] <= cp[1, k] < bounds[3]):
+            out = k
+    return out
+
+
+# ---- grid -> particles ------------------------------------------------------------------
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
+                           plane_stress, geom, ga, gvn, dt, dt_stress, damping, pdamp, bounds,
+                           vmax, left, bad, wij, wc, vfld, gbuf, nch, ncx, ncy, cstart, chords,
+                           cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, use_position,
+                           counts):
+    """Grid -> particles from each particle's own fields, then its new weights, fields
+    (crossing the moved cracks) and mass and momentum back to the grid."""
+    n = pos.shape[1]
+    nnx = int(geom[4])
+    nf = gbuf.shape[1]
+    idx = 1.0 / geom[2]
+    idy = 1.0 / geom[3]
+    for c in prange(nch):
+        buf = gbuf[c]
+        _clear_extrapolation_rows(buf)
+        lo = c * n // nch
+        hi = (c + 1) * n // nch
+        bad[c, 0] = -1
+        conflicts = 0
+        for p in range(lo, hi):
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            ax = 0.0
+            ay = 0.0
+            vx = 0.0
+            vy = 0.0
+            L00 = 0.0
+            L01 = 0.0
+            L10 = 0.0
+            L11 = 0.0
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    f = vfld[p, b * NA + a]
+                    s = r[a] * sy
+                    ax += s * ga[f, 0, k]
+                    ay += s * ga[f, 1, k]
+                    vnx = gvn[f, 0, k]
+                    vny = gvn[f, 1, k]
+                    vx += s * vnx
+                    vy += s * vny
+                    if dt_stress > 0.0:
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        L00 += vnx * gx
+                        L01 += vnx * gy
+                        L10 += vny * gx
+                        L11 += vny * gy
+            vmx = vx - ax * dt
+            vmy = vy - ay * dt
+            dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
+            dvy = (ay - damping * vmy - pdamp[p] * vel[1, p]) * dt
+            nvx = vel[0, p] + dvx
+            nvy = vel[1, p] + dvy
+            vel[0, p] = nvx
+            vel[1, p] = nvy
+            x = pos[0, p] + (vmx + 0.5 * dvx) * dt
+            y = pos[1, p] + (vmy + 0.5 * dvy) * dt
+            if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
+                if left[p] == 0:
+                    left[p] = 1
+                    bad[c, 2] += 1
+                    bad[c, 3] = p
+                x = pos[0, p]
+                y = pos[1, p]
+            pos[0, p] = x
+            pos[1, p] = y
+            if dt_stress > 0.0:
+                _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
+                               mat_params, plane_stress)
+            if bad[c, 0] < 0:
+                if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
+                        and math.isfinite(y) and math.isfinite(stress[0, p])):
+                    bad[c, 0] = p
+                    bad[c, 1] = STATUS_NONFINITE
+                elif nvx * nvx + nvy * nvy > vmax * vmax:
+                    bad[c, 0] = p
+                    bad[c, 1] = STATUS_RUNAWAY
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
+                                          nnx, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
+                                          clast, cext0, cext1, ccrack, nslot, nf,
+                                          use_position, conflicts)
+        counts[c] = conflicts
+
+
+@njit(cache=True, error_model="numpy")
+def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
+    for q in range(pbc_part.size):
+        p = pbc_part[q]
+        d = pbc_dir[q]
+        rec_work[pbc_rec[q]] += pload[q] * (pos[d, p] - pos_before[q])
+
+
+@njit(cache=True)
+def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, nslot):
+    """Chords near each cell and the crack slots of every node, for the current plane."""
+    cstart, chords = cell_segments(cp[0], cp[1], cfirst, clast, cext0, cext1, ccrack, geom,
+                                   ncx, ncy)
+    node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot)
+    return cstart, chords
+
+
+@njit(cache=True, error_model="numpy")
+def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
+            pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp, mat_params,
+            geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax, left, leave_limit,
+            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+            rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
+            sym_out, sym_in, sym_dir, bad, nch,
+            cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
+            law1, law2, thickness, use_position, cutoff_cells, vfld, wij, wc, nslot, counts,
+            chunk_counts):
+    """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
+
+    Order per step: loads and internal forces into each particle's fields; crack
+    tractions; contact after the update; velocity conditions; cracks moved; particles
+    updated and extrapolated to the next step's fields (crossing the moved cracks);
+    contact on the new momenta; velocity conditions.  Returns (steps done, status,
+    offending particle or crack particle).
+    """
+    n = pos.shape[1]
+    nn = g.shape[2]
+    nnx = int(geom[4])
+    ncx = nnx - 1
+    ncy = nn // nnx - 1
+    pload = np.zeros(pbc_part.size)
+    pos_before = np.zeros(pbc_part.size)
+    if method == USF:
+        dt_first = dt
+        dt_last = 0.0
+    elif method == USL:
+        dt_first = 0.0
+        dt_last = dt
+    else:
+        dt_first = 0.5 * dt
+        dt_last = dt - dt_first
+    plus = post_extrapolate and dt_last > 0.0
+    dt_update = 0.0 if post_extrapolate else dt_last
+    cpx = cp[0]
+    cpy = cp[1]
+    cstart, chords = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
+                                 nslot)
+    weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, ncx, ncy,
+                     cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                     g.shape[0], use_position, chunk_counts)
+    for c in range(nch):
+        counts[C_CONFLICT] += chunk_counts[c]
+    reduce_extrapolation(gbuf, g, gv, nch)
+    contact(g, gv, nslot, dt, False, use_position, cutoff_cells, geom)
+    momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
+                        rec_ftime, sym_out, sym_in, sym_dir, t)
+    pending = 0.0
+    for step in range(nsteps):
+        rec_force[:] = 0.0
+        g[:, GFX] = 0.0
+        g[:, GFY] = 0.0
+        scatter_loads(pos, F, geom, g, wij, wc, vfld, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+                      rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
+        for q in range(pbc_part.size):
+            pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
+        stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, geom, wij,
+                     wc, vfld, gv, gbuf, nch, pending, dt_first, True, n)
+        pending = 0.0
+        reduce_forces(gbuf, g, nch)
+        crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
+                        cext1, ccrack, nslot, claw, cstate, chist, law1, law2, thickness,
+                        counts)
+        contact(g, gv, nslot, dt, True, use_position, cutoff_cells, geom)
+        accelerations(g, ga, gvn, dt)
+        velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec,
+                                  rec_style, rec_value, rec_t0, rec_ftime, rec_force,
+                                  rec_work, sym_out, sym_in, sym_dir, t, dt)
+        out = move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast,
+                          cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
+        if out >= 0:
+            return step + 1, STATUS_CRACK_LEFT_GRID, out
+        cstart, chords = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
+                                     nnx, nslot)
+        update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
+                               plane_stress, geom, ga, gvn, dt, dt_update, damping, pdamp,
+                               bounds, vmax, left, bad, wij, wc, vfld, gbuf, nch, ncx, ncy,
+                               cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                               nslot, use_position, chunk_counts)
+        for c in range(nch):
+            counts[C_CONFLICT] += chunk_counts[c]
+        _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
+        t += dt
+        reduce_extrapolation(gbuf, g, gv, nch)
+        contact(g, gv, nslot, dt, False, use_position, cutoff_cells, geom)
+        momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
+                            rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
+        if plus:
+            pending = dt_last
+        n_left = 0
+        stop = -1
+        for c in range(nch):
+            if bad[c, 0] >= 0:
+                stop = c
+                break
+            n_left += bad[c, 2]
+        status = STATUS_OK
+        who = -1
+        if stop >= 0:
+            status = bad[stop, 1]
+            who = bad[stop, 0]
+        elif n_left >= leave_limit:
+            for c in range(nch):
+                if bad[c, 2] > 0:
+                    status = STATUS_LEFT_GRID
+                    who = bad[c, 3]
+                    break
+        if status != STATUS_OK or step == nsteps - 1:
+            if pending > 0.0:
+                stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
+                             geom, wij, wc, vfld, gv, gbuf, nch, 0.0, pending, False, n)
+            if status != STATUS_OK:
+                return step + 1, status, who
+    return nsteps, STATUS_OK, -1

@@ -1,0 +1,254 @@
+"""The cracks of one simulation: their state, the crack step and the crack results.
+
+``CrackScene`` holds the crack particles (``CrackSet``), the traction laws they use,
+the kernel arrays, and computes at archive times what ``cracks.csv`` reports: the
+contour J(x) at each crack tip, the traction-loaded zone behind it (tip to notch
+root), W_B at the crossing and at the root, and from them J_tip and J_ff by the
+seed paper's Eqs 11-13:
+
+* contour crossing inside the zone at x:  J_tip = J(x) - W_B(x),  J_ff = J_tip + W_B(root)
+* contour enclosing the whole zone:       J_ff = J(x),           J_tip = J_ff - W_B(root)
+
+W_B(x) is the work the crack-face tractions have done per unit area at x: the area
+under the envelope while loading, less what was given back along the linear unloading
+to the origin (seed Appendix).  The root is the crack particle farthest from the tip
+in the unbroken run of traction-carrying particles that starts at (or next to) the tip.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .geometry import EXTERIOR_END, CrackSet
+from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_intensity,
+                        tip_cod, to_mpa_sqrt_m)
+
+INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
+NO_MODE = -1.0
+
+
+@dataclass
+class Tip:
+    crack: int          # 0-based crack index
+    end: str            # 'start' or 'end'
+    material: int       # 0-based material index of the tip (for K); -1 unknown
+
+
+@dataclass
+class CrackScene:
+    cracks: CrackSet
+    laws: dict                      # material index -> traction-law plugin instance
+    tips: list                      # Tip records that get J
+    jcontour_size: int = 2
+    contact_position: float | None = None   # ContactPosition (cells) or None
+    jcontour_sizes: list = field(default_factory=list)   # extra sizes for jcontours.csv
+    jcontour_time: float | None = None                   # ms
+
+    def __post_init__(self):
+        cs = self.cracks
+        nc = cs.plane.shape[1]
+        self.state = np.where(cs.law >= 0, ACTIVE, INTACT).astype(np.int8)
+        self.hist = np.zeros((2, nc))
+        self.counts = np.zeros(4, dtype=np.int64)
+        self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
+        self.initial_root = {(t.crack, t.end): self.zone(t)[1] for t in self.tips}
+        self.kernels = None
+
+    # ---- kernel side ---------------------------------------------------------------
+    def prepare(self, sim) -> None:
+        from ..core.kernel_build import load_crack_kernels
+        cs = self.cracks
+        used = sorted(self.laws)
+        functions = sorted({self.laws[m].envelope_function for m in used})
+        nlaw = len(sim.materials)
+        width = 1 + max([len(self.laws[m].param_vector(1)) for m in used]
+                        + [len(self.laws[m].param_vector(2)) for m in used
+                           if self.laws[m].has_mode(2)] + [1])
+        self.law1 = np.full((nlaw, width), NO_MODE)
+        self.law2 = np.full((nlaw, width), NO_MODE)
+        for m in used:
+            law = self.laws[m]
+            for mode, table in ((1, self.law1), (2, self.law2)):
+                if law.has_mode(mode):
+                    par = law.param_vector(mode)
+                    table[m, 0] = functions.index(law.envelope_function)
+                    table[m, 1:1 + len(par)] = par
+        self.kernels = load_crack_kernels(sim.kernels, functions)
+        self.nf = 2 if cs.n_cracks == 1 else 4
+        nn = sim.grid.n_nodes
+        n = sim.particles.n
+        na = 2 if sim.shape == 0 else 3
+        self.g = np.zeros((self.nf, 10, nn))
+        self.gbuf = np.zeros((sim.nch, self.nf, 10, nn))
+        self.gv = np.zeros((self.nf, 2, nn))
+        self.ga = np.zeros((self.nf, 2, nn))
+        self.gvn = np.zeros((self.nf, 2, nn))
+        self.vfld = np.zeros((n, na * na), dtype=np.int8)
+        self.wij = np.zeros((n, 2), dtype=np.int64)
+        self.wc = np.zeros((n, 12))
+        self.nslot = np.full((2, nn), -1, dtype=np.int64)
+        self.chunk_counts = np.zeros(sim.nch, dtype=np.int64)
+        self.cfirst = np.ascontiguousarray(cs.first, dtype=np.int64)
+        self.clast = np.ascontiguousarray(cs.first + cs.count - 1, dtype=np.int64)
+        self.cext0 = np.ascontiguousarray(cs.tips[:, 0] == EXTERIOR_END)
+        self.cext1 = np.ascontiguousarray(cs.tips[:, 1] == EXTERIOR_END)
+        self.ccrack = np.ascontiguousarray(cs.crack, dtype=np.int64)
+        self.cfixed = np.ascontiguousarray(cs.fixed, dtype=np.bool_)
+        self.claw = np.ascontiguousarray(cs.law, dtype=np.int64)
+
+    def advance(self, sim, nsteps: int):
+        p = sim.particles
+        c = sim.cond_arrays
+        cs = self.cracks
+        use_position = self.contact_position is not None
+        return self.kernels.advance(
+            nsteps, sim.time, sim.dt, sim.method, sim.post_extrapolate, sim.plane_stress,
+            p.pos, p.pos0, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress, p.hist, p.w,
+            p.pdamp, sim.mat_params, sim.geom, sim.bounds, self.g, self.gbuf, self.gv,
+            self.ga, self.gvn, sim.gtmp, sim.damping, sim.vmax, sim.left, sim.leave_max,
+            c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
+            c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
+            c["rec_ftime"], sim.rec_force, sim.rec_work, sim.sym_out, sim.sym_in, sim.sym_dir,
+            sim.bad, sim.nch, cs.plane, cs.above, cs.below, self.cfirst, self.clast,
+            self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
+            self.law1, self.law2, float(sim.grid.thickness), use_position,
+            float(self.contact_position or 0.0), self.vfld, self.wij, self.wc, self.nslot,
+            self.counts, self.chunk_counts)
+
+    # ---- zone and traction work -------------------------------------------------------
+    def _tip_point(self, tip: Tip) -> np.ndarray:
+        cs = self.cracks
+        k = cs.first[tip.crack] + (0 if tip.end == "start" else cs.count[tip.crack] - 1)
+        return cs.plane[:, k]
+
+    def _walk(self, tip: Tip) -> np.ndarray:
+        """Crack-particle indices from the tip backwards."""
+        cs = self.cracks
+        s, n = int(cs.first[tip.crack]), int(cs.count[tip.crack])
+        idx = np.arange(s, s + n)
+        return idx if tip.end == "start" else idx[::-1]
+
+    def zone(self, tip: Tip) -> tuple[list[int], int]:
+        """(crack particles of the traction zone from the tip side, root particle);
+        no zone gives ([], tip particle)."""
+        walk = self._walk(tip)
+        zone = []
+        for k in walk:
+            if self.state[k] == ACTIVE:
+                zone.append(int(k))
+            elif zone:
+                break
+            elif k != walk[0] and k != walk[1]:
+                break   # the zone must start at the tip or its neighbour
+        return zone, (zone[-1] if zone else int(walk[0]))
+
+    def traction_work(self, k: int) -> float:
+        """W_B (J/m^2) done by the tractions of crack particle k so far."""
+        law_index = int(self.cracks.law[k])
+        if law_index < 0 or law_index not in self.laws:
+            return 0.0
+        law = self.laws[law_index]
+        if self.state[k] == FAILED:
+            return float(law.area(1))
+        dn, _ = self.cod_at(k)
+        h = self.hist[0, k]
+        if dn >= h:
+            return float(law.work_to(max(dn, 0.0), 1))
+        if h <= 0.0:
+            return 0.0
+        s_h = float(law.envelope(h, 1))
+        return float(law.work_to(h, 1)) - 0.5 * s_h * h * 1000.0 * (1.0 - (max(dn, 0.0) / h) ** 2)
+
+    def recoverable_work(self, k: int) -> float:
+        """W_B^(r) (J/m^2): what linear unloading from the current state gives back."""
+        law_index = int(self.cracks.law[k])
+        if law_index < 0 or law_index not in self.laws or self.state[k] != ACTIVE:
+            return 0.0
+        law = self.laws[law_index]
+        dn, _ = self.cod_at(k)
+        h = self.hist[0, k]
+        if h <= 0.0:
+            return 0.0
+        s_h = float(law.envelope(h, 1))
+        d = min(max(dn, 0.0), h)
+        return 0.5 * s_h / h * d * d * 1000.0
+
+    def cod_at(self, k: int) -> tuple[float, float]:
+        """(normal, tangential) opening (mm) at crack particle k."""
+        cs = self.cracks
+        c = cs.crack[k]
+        s, n = cs.first[c], cs.count[c]
+        kp, kn = max(k - 1, s), min(k + 1, s + n - 1)
+        t = cs.plane[:, kn] - cs.plane[:, kp]
+        t = t / np.hypot(t[0], t[1])
+        d = cs.above[:, k] - cs.below[:, k]
+        return float(-t[1] * d[0] + t[0] * d[1]), float(t[0] * d[0] + t[1] * d[1])
+
+    # ---- J at the tips ------------------------------------------------------------------
+    def tip_results(self, sim, sizes=None) -> list[dict]:
+        """One dict per tip (per contour size when ``sizes`` is given) with the
+        cracks.csv columns."""
+        fields = nodal_fields(sim.grid, sim.particles, self.cracks, sim.shape, strict=False)
+        rows = []
+        for tip in self.tips:
+            for size in (sizes or [self.jcontour_size]):
+                rows.append(self._tip_row(sim, fields, tip, int(size)))
+        return rows
+
+    def _tip_row(self, sim, fields, tip: Tip, size: int) -> dict:
+        cs = self.cracks
+        key = (tip.crack, tip.end)
+        xt = self._tip_point(tip)
+        zone, root = self.zone(tip)
+        root_xy = cs.plane[:, root]
+        w_root = self.traction_work(root) if zone else 0.0
+        w_rec = self.recoverable_work(root) if zone else 0.0
+        row = {"time_ms": sim.time, "crack": tip.crack + 1, "tip": tip.end,
+               "contour_cells": size,
+               "tip_x_mm": float(xt[0]), "tip_y_mm": float(xt[1]),
+               "crack_growth_mm": float(np.hypot(*(xt - self.initial_tips[key]))),
+               "root_x_mm": float(root_xy[0]), "root_y_mm": float(root_xy[1]),
+               "zone_length_mm": float(np.hypot(*(xt - root_xy))) if zone else 0.0,
+               "J_contour_J_m2": math.nan, "J_tip_J_m2": math.nan, "J_ff_J_m2": math.nan,
+               "W_B_crossing_J_m2": math.nan,
+               "W_B_root_J_m2": w_root, "W_B_rec_root_J_m2": w_rec, "R_J_m2": math.nan,
+               "cod_root_mm": self.cod_at(root)[0],
+               "cod_notch0_mm": self.cod_at(self.initial_root[key])[0],
+               "KI_MPa_sqrt_m": math.nan, "KII_MPa_sqrt_m": math.nan, "error": ""}
+        try:
+            res = j_integral(sim.grid, fields, cs, tip.crack, tip.end, size)
+        except ValueError as exc:
+            row["error"] = str(exc)
+            return row
+        j_x = res.J1 * N_PER_MM_TO_J_PER_M2
+        a, b, f = res.crossing_particle, res.crossing_beyond, res.crossing_fraction
+        if a in zone or b in zone:          # the contour crosses the traction zone
+            w_cross = ((1.0 - f) * (self.traction_work(a) if a in zone else 0.0)
+                       + f * (self.traction_work(b) if b in zone else 0.0))
+            j_tip = j_x - w_cross
+            j_ff = j_tip + w_root
+        elif zone and self._beyond_root(tip, a, zone):   # it encloses the whole zone
+            w_cross = 0.0
+            j_ff = j_x
+            j_tip = j_ff - w_root
+        else:                               # it crosses between the tip and the zone
+            w_cross = 0.0
+            j_tip = j_x
+            j_ff = j_tip + w_root
+        row.update({"J_contour_J_m2": j_x, "J_tip_J_m2": j_tip, "J_ff_J_m2": j_ff,
+                    "W_B_crossing_J_m2": w_cross})
+        if tip.material >= 0:
+            consts = sim.materials[tip.material].shear_and_poisson()
+            if consts is not None:
+                dn, dt = tip_cod(cs, tip.crack, tip.end)
+                k1, k2 = stress_intensity(j_tip / N_PER_MM_TO_J_PER_M2, dn, dt, consts[0],
+                                          consts[1], sim.plane_stress)
+                row["KI_MPa_sqrt_m"] = to_mpa_sqrt_m(k1)
+                row["KII_MPa_sqrt_m"] = to_mpa_sqrt_m(k2)
+        return row
+
+    def _beyond_root(self, tip: Tip, k: int, zone: list[int]) -> bool:
+        walk = list(self._walk(tip))
+        return walk.index(k) > walk.index(zone[-1])
