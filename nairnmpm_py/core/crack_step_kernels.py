@@ -145,7 +145,23 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
         mux = m * (x - pos0[0, p])
         muy = m * (y - pos0[1, p])
     cell = _cell_of(x, y, geom, ncx, ncy)
-    near = cstart[cell + 1] > cstart[cell]
+    if cstart[cell + 1] == cstart[cell]:
+        # no chord near this particle: every node in field 0 (the common, fast case)
+        b0 = buf[0]
+        for b in range(NA):
+            sy = r[3 + b]
+            row = (j0 + b) * nnx + i0
+            for a in range(NA):
+                s = sy * r[a]
+                k = row + a
+                vfld[p, b * NA + a] = 0
+                b0[GM, k] += s * m
+                b0[GPX, k] += s * mvx
+                b0[GPY, k] += s * mvy
+                b0[GUX, k] += s * mux
+                b0[GUY, k] += s * muy
+        return conflicts
+    near = True
     for b in range(NA):
         sy = r[3 + b]
         row = (j0 + b) * nnx + i0
@@ -153,7 +169,7 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
             s = sy * r[a]
             k = row + a
             f = 0
-            if near:
+            if near and nslot[0, k] >= 0:
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
                 f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords,
@@ -216,13 +232,22 @@ def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, n
 
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def reduce_extrapolation(gbuf, g, gv, nch):
-    """Sum the chunks' extrapolated rows; velocities of every field."""
+def reduce_extrapolation(gbuf, g, gv, nch, cnodes):
+    """Sum the chunks' extrapolated rows (the contact rows only at the crack nodes);
+    velocities of every field."""
     nf = g.shape[0]
     nn = g.shape[2]
+    for q in range(cnodes.size):
+        k = cnodes[q]
+        for f in range(nf):
+            for row in (GUX, GUY, GNX, GNY, GSD):
+                s = 0.0
+                for c in range(nch):
+                    s += gbuf[c, f, row, k]
+                g[f, row, k] = s
     for k in prange(nn):
         for f in range(nf):
-            for row in (GM, GPX, GPY, GUX, GUY, GNX, GNY, GSD):
+            for row in (GM, GPX, GPY):
                 s = 0.0
                 for c in range(nch):
                     s += gbuf[c, f, row, k]
@@ -283,14 +308,14 @@ def _contact_pair(g, k, fa, fb, nx, ny, dt, after_update, use_position, cutoff):
         g[fb, GPY, k] -= cy
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def contact(g, gv, nslot, dt, after_update, use_position, cutoff_cells, geom):
+@njit(cache=True, error_model="numpy")
+def contact(g, gv, nslot, cnodes, dt, after_update, use_position, cutoff_cells, geom):
     """Contact across each slot's crack: fields (0, 1) and (2, 3) across slot 0,
     (0, 2) and (1, 3) across slot 1.  The slot's accumulated side says which field is
     above; its accumulated normal is the contact normal."""
     nf = g.shape[0]
-    nn = g.shape[2]
-    for k in prange(nn):
+    for q in range(cnodes.size):
+        k = cnodes[q]
         touched = False
         for s in range(2):
             if nslot[s, k] < 0 or (s == 1 and nf < 4):
@@ -828,11 +853,12 @@ def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
 
 @njit(cache=True)
 def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, nslot):
-    """Chords near each cell and the crack slots of every node, for the current plane."""
+    """Chords near each cell, the crack slots of every node and the nodes that have
+    one (the only nodes where fields can differ), for the current plane."""
     cstart, chords = cell_segments(cp[0], cp[1], cfirst, clast, cext0, cext1, ccrack, geom,
                                    ncx, ncy)
     node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot)
-    return cstart, chords
+    return cstart, chords, np.flatnonzero(nslot[0] >= 0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -873,15 +899,15 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     dt_update = 0.0 if post_extrapolate else dt_last
     cpx = cp[0]
     cpy = cp[1]
-    cstart, chords = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
+    cstart, chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
                                  nslot)
     weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, ncx, ncy,
                      cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
                      g.shape[0], use_position, chunk_counts)
     for c in range(nch):
         counts[C_CONFLICT] += chunk_counts[c]
-    reduce_extrapolation(gbuf, g, gv, nch)
-    contact(g, gv, nslot, dt, False, use_position, cutoff_cells, geom)
+    reduce_extrapolation(gbuf, g, gv, nch, cnodes)
+    contact(g, gv, nslot, cnodes, dt, False, use_position, cutoff_cells, geom)
     momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                         rec_ftime, sym_out, sym_in, sym_dir, t)
     pending = 0.0
@@ -900,7 +926,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
                         cext1, ccrack, nslot, claw, cstate, chist, law1, law2, thickness,
                         counts)
-        contact(g, gv, nslot, dt, True, use_position, cutoff_cells, geom)
+        contact(g, gv, nslot, cnodes, dt, True, use_position, cutoff_cells, geom)
         accelerations(g, ga, gvn, dt)
         velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec,
                                   rec_style, rec_value, rec_t0, rec_ftime, rec_force,
@@ -909,7 +935,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
         if out >= 0:
             return step + 1, STATUS_CRACK_LEFT_GRID, out
-        cstart, chords = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
+        cstart, chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
                                      nnx, nslot)
         update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                                plane_stress, geom, ga, gvn, dt, dt_update, damping, pdamp,
@@ -920,8 +946,8 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             counts[C_CONFLICT] += chunk_counts[c]
         _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
         t += dt
-        reduce_extrapolation(gbuf, g, gv, nch)
-        contact(g, gv, nslot, dt, False, use_position, cutoff_cells, geom)
+        reduce_extrapolation(gbuf, g, gv, nch, cnodes)
+        contact(g, gv, nslot, cnodes, dt, False, use_position, cutoff_cells, geom)
         momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
                             rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
         if plus:

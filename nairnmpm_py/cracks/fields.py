@@ -20,7 +20,10 @@ from numba import njit
 
 from .crossing import segment_crossing_side, tri
 
-SEARCH_PAD_CELLS = 2  # a particle-node line reaches 1.5 cells (uGIMP); keep a margin
+# a chord that cuts a particle-node line lies within the cells next to the particle's
+# cell (uGIMP nodes are at most 1.5 cells away) and within the cells next to the
+# node's four cells, so one cell of padding finds every chord that can matter
+SEARCH_PAD_CELLS = 1
 
 
 @njit(cache=True, inline="always")

@@ -161,7 +161,8 @@ def _crack_scene(r: Reader, model: InputModel, materials: list, names: list):
     h = model.mpm.cracks
     return CrackScene(CrackSet.from_polylines(polylines, laws, tips, fixed), used, tip_list,
                       jcontour_size=h.jcontour_size if h else 2,
-                      contact_position=h.contact_position if h else None)
+                      contact_position=h.contact_position if h else None,
+                      jcontour_sizes=list(h.jcontour_sizes) if h else [])
 
 
 # ---- particles ----------------------------------------------------------------------

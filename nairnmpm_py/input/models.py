@@ -25,6 +25,7 @@ class GlobalArchiveModel(Model):
 class CracksHeaderModel(Model):
     jcontour_type: int = 1
     jcontour_size: int = 2
+    jcontour_sizes: list[int] = []   # ours: sizes (cells) for jcontours.csv
     friction: float = 0.0        # 0 = frictionless (the only kind so far)
     contact_position: float | None = None
     propagate: list[tuple[int, int, int]] = []   # (criterion, direction, traction)

@@ -477,6 +477,18 @@ def _cracks_header(r: Reader, el) -> CracksHeaderModel:
                 r.problem(c, "<JContour> terms=2 and gridenergy=1 are not supported")
             h["jcontour_type"] = a.get("type", 1)
             h["jcontour_size"] = a.get("size", 2)
+        elif c.tag == "JContourSizes":
+            # ours: J on each of these contour half-sizes (cells) into jcontours.csv
+            r.attrs(c, {})
+            text = (c.text or "").replace(",", " ").split()
+            try:
+                sizes = [int(v) for v in text]
+            except ValueError:
+                sizes = []
+            if not sizes or min(sizes) < 1:
+                r.problem(c, "<JContourSizes> needs whole numbers of cells >= 1, e.g. 2 3 4 6 8")
+            else:
+                h["jcontour_sizes"] = sizes
         elif c.tag == "Friction":
             r.attrs(c, {})
             v = r.text(c, float)
