@@ -67,6 +67,18 @@ CASES = {
     "traction-law-three-parameters": ('<Material Type="1" Name="bar">\n    <rho>1</rho>\n    <E>1000</E>\n    <nu>0.3</nu>',
                                       '<Material Type="1" Name="bar">\n    <rho>1</rho>\n    <E>1000</E>\n    <nu>0.3</nu>\n  </Material>\n  <Material Type="14" Name="law">\n    <sigmaI>1</sigmaI>\n    <delIc>0.2</delIc>\n    <JIc>112.5</JIc>',
                                       '<Material Type="14"', r"give two of"),
+    "crack-outside-grid": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <Line xmin="2" ymin="2.1" xmax="30" ymax="2.1" resolution="4"/>\n  </CrackList>',
+                           "<CrackList>", r"crack point 5 \(30, 2.1\) is outside the grid"),
+    "crack-zero-length": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <pt x="2" y="2.1"/>\n    <pt x="2" y="2.1"/>\n    <pt x="8" y="2.1"/>\n  </CrackList>',
+                          "<CrackList>", r"crack segment 1 has zero length"),
+    "crack-crosses-itself": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <pt x="2" y="1"/>\n    <pt x="8" y="3"/>\n    <pt x="8" y="1"/>\n    <pt x="2" y="3"/>\n  </CrackList>',
+                             "<CrackList>", r"crack crosses itself \(segments 1 and 3\)"),
+    "crack-mat-not-a-traction-law": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <Line xmin="-1" ymin="2.1" xmax="10" ymax="2.1" resolution="4" mat="1"/>\n  </CrackList>',
+                                     '<Line xmin="-1"', r"crack mat: material 1 \('bar'\) is not a traction law"),
+    "crack-tip-is-a-traction-law": ("  </Material>\n</JANFEAInput>", '  </Material>\n  <Material Type="14" Name="glue"><sigmaI>1</sigmaI><JIc>100</JIc></Material>\n  <CrackList>\n    <Line xmin="-1" ymin="2.1" xmax="10" ymax="2.1" resolution="4" end_tip="2"/>\n  </CrackList>\n</JANFEAInput>',
+                                    '<Line xmin="-1"', r"crack tip material: material 2 \('glue'\) is not a solid material"),
+    "crack-law-name-unknown": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <Line xmin="-1" ymin="2.1" xmax="10" ymax="2.1" resolution="4" matname="glue"/>\n  </CrackList>',
+                               '<Line xmin="-1"', r"crack mat: no material named 'glue'"),
 }
 
 PROBLEM_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<msg>.+)$")
