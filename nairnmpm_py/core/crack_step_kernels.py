@@ -45,6 +45,10 @@ STATUS_CRACK_LEFT_GRID = 4
 # rows of one velocity field
 GM, GPX, GPY, GFX, GFY, GUX, GUY, GNX, GNY, GSD = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 NR = 10
+# a particle's nodes are within two cells of its cell, and a node has a crack slot
+# when a cell next to it lists a chord: particles farther than this from every
+# listed cell touch no crack node
+NEAR_CELLS = 2
 NUDGE = 1e-4  # cells: a crack surface is tested from just off the plane, on its side
 
 # counters (``ccount``): pairs whose crack is not in the node's slots, surfaces with
@@ -124,12 +128,20 @@ def node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot):
 
 
 # ---- particles -> grid ----------------------------------------------------------------
+# Fields 1-3 and the contact rows (displacement, normal, side) exist only at crack
+# nodes (nodes with a slot, ``cnodes``).  Their chunk-buffer entries are read and
+# zeroed by the reductions, so they never need clearing; ``g`` keeps them zero away
+# from the current crack nodes (``clear_crack_nodes``).  A particle in a cell with no
+# chord within two cells (``cnear`` 0) touches no crack node: it takes the no-crack
+# path (field 0, no crossing tests, ``cut`` 0).
+
 @njit(cache=True, inline="always")
-def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, ncx, ncy,
-                      cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
-                      nf, use_position, conflicts):
-    """Field choice at each node of particle p, then its mass, momentum, displacement
-    (or position) and, for crossed pairs, the crack normal and side onto the grid."""
+def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, cut, nnx, ncx, ncy,
+                      cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                      nslot, nf, use_position, conflicts):
+    """Field choice at each node of particle p, then its mass and momentum (and at crack
+    nodes its displacement or position, and for crossed pairs the crack normal and
+    side) onto the grid."""
     r = wc[p]
     i0 = wij[p, 0]
     j0 = wij[p, 1]
@@ -138,15 +150,9 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
     y = pos[1, p]
     mvx = m * vel[0, p]
     mvy = m * vel[1, p]
-    if use_position:
-        mux = m * x
-        muy = m * y
-    else:
-        mux = m * (x - pos0[0, p])
-        muy = m * (y - pos0[1, p])
     cell = _cell_of(x, y, geom, ncx, ncy)
-    if cstart[cell + 1] == cstart[cell]:
-        # no chord near this particle: every node in field 0 (the common, fast case)
+    if cnear[cell] == 0:
+        cut[p] = 0
         b0 = buf[0]
         for b in range(NA):
             sy = r[3 + b]
@@ -154,14 +160,18 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
             for a in range(NA):
                 s = sy * r[a]
                 k = row + a
-                vfld[p, b * NA + a] = 0
                 b0[GM, k] += s * m
                 b0[GPX, k] += s * mvx
                 b0[GPY, k] += s * mvy
-                b0[GUX, k] += s * mux
-                b0[GUY, k] += s * muy
         return conflicts
-    near = True
+    if use_position:
+        mux = m * x
+        muy = m * y
+    else:
+        mux = m * (x - pos0[0, p])
+        muy = m * (y - pos0[1, p])
+    has_chords = cstart[cell + 1] > cstart[cell]
+    any_cut = 0
     for b in range(NA):
         sy = r[3 + b]
         row = (j0 + b) * nnx + i0
@@ -169,7 +179,8 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
             s = sy * r[a]
             k = row + a
             f = 0
-            if near and nslot[0, k] >= 0:
+            slotted = nslot[0, k] >= 0
+            if slotted and has_chords:
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
                 f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords,
@@ -192,65 +203,76 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, nnx, nc
                     buf[2, GNY, k] -= w * ex / el
                     buf[2, GSD, k] += w * s1
             vfld[p, b * NA + a] = f
+            any_cut |= f
             fb = buf[f]
             fb[GM, k] += s * m
             fb[GPX, k] += s * mvx
             fb[GPY, k] += s * mvy
-            fb[GUX, k] += s * mux
-            fb[GUY, k] += s * muy
+            if slotted:
+                fb[GUX, k] += s * mux
+                fb[GUY, k] += s * muy
+    cut[p] = 1 if any_cut else 0
     return conflicts
 
 
-@njit(cache=True, inline="always")
-def _clear_extrapolation_rows(buf):
-    for f in range(buf.shape[0]):
-        for row in (GM, GPX, GPY, GUX, GUY, GNX, GNY, GSD):
-            buf[f, row] = 0.0
-
-
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, ncx, ncy,
-                     cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
-                     nf, use_position, counts):
+def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
+                     cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                     nslot, nf, use_position, counts):
     n = pos.shape[1]
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
     idy = 1.0 / geom[3]
     for c in prange(nch):
         buf = gbuf[c]
-        _clear_extrapolation_rows(buf)
+        buf[0, GM] = 0.0
+        buf[0, GPX] = 0.0
+        buf[0, GPY] = 0.0
         lo = c * n // nch
         hi = (c + 1) * n // nch
         conflicts = 0
         for p in range(lo, hi):
             _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
             conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
-                                          nnx, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
-                                          clast, cext0, cext1, ccrack, nslot, nf,
+                                          cut, nnx, ncx, ncy, cstart, chords, cnear, cpx, cpy,
+                                          cfirst, clast, cext0, cext1, ccrack, nslot, nf,
                                           use_position, conflicts)
         counts[c] = conflicts
 
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
 def reduce_extrapolation(gbuf, g, gv, nch, cnodes):
-    """Sum the chunks' extrapolated rows (the contact rows only at the crack nodes);
-    velocities of every field."""
+    """Sum the chunks' extrapolated rows: field 0's mass and momentum everywhere, the
+    rest at the crack nodes (zeroing those buffer entries); velocities."""
     nf = g.shape[0]
     nn = g.shape[2]
+    for k in prange(nn):
+        m = 0.0
+        px = 0.0
+        py = 0.0
+        for c in range(nch):
+            m += gbuf[c, 0, GM, k]
+            px += gbuf[c, 0, GPX, k]
+            py += gbuf[c, 0, GPY, k]
+        g[0, GM, k] = m
+        g[0, GPX, k] = px
+        g[0, GPY, k] = py
+        if m > 0.0:
+            gv[0, 0, k] = px / m
+            gv[0, 1, k] = py / m
+        else:
+            gv[0, 0, k] = 0.0
+            gv[0, 1, k] = 0.0
     for q in range(cnodes.size):
         k = cnodes[q]
         for f in range(nf):
-            for row in (GUX, GUY, GNX, GNY, GSD):
+            for row in (GM, GPX, GPY, GUX, GUY, GNX, GNY, GSD):
+                if f == 0 and row <= GPY:
+                    continue
                 s = 0.0
                 for c in range(nch):
                     s += gbuf[c, f, row, k]
-                g[f, row, k] = s
-    for k in prange(nn):
-        for f in range(nf):
-            for row in (GM, GPX, GPY):
-                s = 0.0
-                for c in range(nch):
-                    s += gbuf[c, f, row, k]
+                    gbuf[c, f, row, k] = 0.0
                 g[f, row, k] = s
             m = g[f, GM, k]
             if m > 0.0:
@@ -259,6 +281,25 @@ def reduce_extrapolation(gbuf, g, gv, nch, cnodes):
             else:
                 gv[f, 0, k] = 0.0
                 gv[f, 1, k] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def clear_crack_nodes(g, gv, ga, gvn, cnodes):
+    """Zero fields 1-3 and the contact rows at the crack nodes before the cracks move
+    and the crack nodes change, so away from crack nodes those stay zero."""
+    nf = g.shape[0]
+    for q in range(cnodes.size):
+        k = cnodes[q]
+        for f in range(nf):
+            for row in range(g.shape[1]):
+                if f == 0 and row <= GFY:
+                    continue
+                g[f, row, k] = 0.0
+            if f > 0:
+                for d in range(2):
+                    gv[f, d, k] = 0.0
+                    ga[f, d, k] = 0.0
+                    gvn[f, d, k] = 0.0
 
 
 # ---- contact --------------------------------------------------------------------------
@@ -444,7 +485,7 @@ def velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec
 
 # ---- forces ------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def scatter_loads(pos, F, geom, g, wij, wc, vfld, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+def scatter_loads(pos, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                   rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
     nnx = int(geom[4])
     for q in range(pbc_part.size):
@@ -459,28 +500,30 @@ def scatter_loads(pos, F, geom, g, wij, wc, vfld, pbc_part, pbc_dir, pbc_scale, 
         for b in range(NA):
             row = (wij[p, 1] + b) * nnx + wij[p, 0]
             for a in range(NA):
-                g[vfld[p, b * NA + a], row_c, row + a] += w[3 + b] * w[a] * f
+                fld = vfld[p, b * NA + a] if cut[p] else 0
+                g[fld, row_c, row + a] += w[3 + b] * w[a] * f
 
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
 def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, geom, wij, wc,
-                 vfld, gv, gbuf, nch, dt_pre, dt_stress, scatter, n):
+                 vfld, cut, gv, gbuf, nch, dt_pre, dt_stress, scatter, n):
     """Stress update from each particle's own fields' velocities, internal forces into
-    the same fields."""
+    the same fields (particles not cut by a crack: field 0 only, as without cracks)."""
     nnx = int(geom[4])
-    nf = gbuf.shape[1]
+    gv0 = gv[0]
     for c in prange(nch):
         buf = gbuf[c]
+        b0 = buf[0]
         if scatter:
-            for f in range(nf):
-                buf[f, GFX] = 0.0
-                buf[f, GFY] = 0.0
+            b0[GFX] = 0.0
+            b0[GFY] = 0.0
         lo = c * n // nch
         hi = (c + 1) * n // nch
         for p in range(lo, hi):
             r = wc[p]
             i0 = wij[p, 0]
             j0 = wij[p, 1]
+            cp_ = cut[p]
             if dt_stress > 0.0 or dt_pre > 0.0:
                 L00 = 0.0
                 L01 = 0.0
@@ -492,13 +535,19 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
                     row = (j0 + b) * nnx + i0
                     for a in range(NA):
                         k = row + a
-                        f = vfld[p, b * NA + a]
                         gx = r[6 + a] * sy
                         gy = r[a] * dy
-                        L00 += gv[f, 0, k] * gx
-                        L01 += gv[f, 0, k] * gy
-                        L10 += gv[f, 1, k] * gx
-                        L11 += gv[f, 1, k] * gy
+                        if cp_:
+                            f = vfld[p, b * NA + a]
+                            vx = gv[f, 0, k]
+                            vy = gv[f, 1, k]
+                        else:
+                            vx = gv0[0, k]
+                            vy = gv0[1, k]
+                        L00 += vx * gx
+                        L01 += vx * gy
+                        L10 += vy * gx
+                        L11 += vy * gy
                 if dt_pre > 0.0:
                     _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
                                    mat_params, plane_stress)
@@ -517,45 +566,70 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
                 row = (j0 + b) * nnx + i0
                 for a in range(NA):
                     k = row + a
-                    f = vfld[p, b * NA + a]
                     gx = r[6 + a] * sy
                     gy = r[a] * dy
-                    buf[f, GFX, k] -= sxx * gx + sxy * gy
-                    buf[f, GFY, k] -= sxy * gx + syy * gy
+                    if cp_:
+                        fb = buf[vfld[p, b * NA + a]]
+                        fb[GFX, k] -= sxx * gx + sxy * gy
+                        fb[GFY, k] -= sxy * gx + syy * gy
+                    else:
+                        b0[GFX, k] -= sxx * gx + sxy * gy
+                        b0[GFY, k] -= sxy * gx + syy * gy
 
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def reduce_forces(gbuf, g, nch):
+def reduce_forces(gbuf, g, nch, cnodes):
+    """Add the chunks' internal forces: field 0 everywhere, fields 1-3 at the crack
+    nodes (zeroing those buffer entries)."""
     nf = g.shape[0]
     nn = g.shape[2]
     for k in prange(nn):
-        for f in range(nf):
+        fx = 0.0
+        fy = 0.0
+        for c in range(nch):
+            fx += gbuf[c, 0, GFX, k]
+            fy += gbuf[c, 0, GFY, k]
+        g[0, GFX, k] += fx
+        g[0, GFY, k] += fy
+    for q in range(cnodes.size):
+        k = cnodes[q]
+        for f in range(1, nf):
             fx = 0.0
             fy = 0.0
             for c in range(nch):
                 fx += gbuf[c, f, GFX, k]
                 fy += gbuf[c, f, GFY, k]
+                gbuf[c, f, GFX, k] = 0.0
+                gbuf[c, f, GFY, k] = 0.0
             g[f, GFX, k] += fx
             g[f, GFY, k] += fy
 
 
+@njit(cache=True, inline="always")
+def _accelerate(g, ga, gvn, f, k, dt):
+    m = g[f, GM, k]
+    if m > 0.0:
+        inv = 1.0 / m
+        ga[f, 0, k] = g[f, GFX, k] * inv
+        ga[f, 1, k] = g[f, GFY, k] * inv
+        gvn[f, 0, k] = (g[f, GPX, k] + g[f, GFX, k] * dt) * inv
+        gvn[f, 1, k] = (g[f, GPY, k] + g[f, GFY, k] * dt) * inv
+    else:
+        ga[f, 0, k] = 0.0
+        ga[f, 1, k] = 0.0
+        gvn[f, 0, k] = 0.0
+        gvn[f, 1, k] = 0.0
+
+
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def accelerations(g, ga, gvn, dt):
+def accelerations(g, ga, gvn, dt, cnodes):
     nf = g.shape[0]
     nn = g.shape[2]
     for k in prange(nn):
-        for f in range(nf):
-            m = g[f, GM, k]
-            if m > 0.0:
-                ga[f, 0, k] = g[f, GFX, k] / m
-                ga[f, 1, k] = g[f, GFY, k] / m
-                gvn[f, 0, k] = (g[f, GPX, k] + g[f, GFX, k] * dt) / m
-                gvn[f, 1, k] = (g[f, GPY, k] + g[f, GFY, k] * dt) / m
-            else:
-                ga[f, 0, k] = 0.0
-                ga[f, 1, k] = 0.0
-                gvn[f, 0, k] = 0.0
-                gvn[f, 1, k] = 0.0
+        _accelerate(g, ga, gvn, 0, k, dt)
+    for q in range(cnodes.size):
+        for f in range(1, nf):
+            _accelerate(g, ga, gvn, f, cnodes[q], dt)
 
 
 # ---- crack particles ------------------------------------------------------------------
@@ -755,9 +829,9 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
 def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                            plane_stress, geom, ga, gvn, dt, dt_stress, damping, pdamp, bounds,
-                           vmax, left, bad, wij, wc, vfld, gbuf, nch, ncx, ncy, cstart, chords,
-                           cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, use_position,
-                           counts):
+                           vmax, left, bad, wij, wc, vfld, cut, gbuf, nch, ncx, ncy, cstart,
+                           chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                           use_position, counts):
     """Grid -> particles from each particle's own fields, then its new weights, fields
     (crossing the moved cracks) and mass and momentum back to the grid."""
     n = pos.shape[1]
@@ -765,9 +839,13 @@ def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, ma
     nf = gbuf.shape[1]
     idx = 1.0 / geom[2]
     idy = 1.0 / geom[3]
+    ga0 = ga[0]
+    gvn0 = gvn[0]
     for c in prange(nch):
         buf = gbuf[c]
-        _clear_extrapolation_rows(buf)
+        buf[0, GM] = 0.0
+        buf[0, GPX] = 0.0
+        buf[0, GPY] = 0.0
         lo = c * n // nch
         hi = (c + 1) * n // nch
         bad[c, 0] = -1
@@ -784,18 +862,25 @@ def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, ma
             L01 = 0.0
             L10 = 0.0
             L11 = 0.0
+            cp_ = cut[p]
             for b in range(NA):
                 sy = r[3 + b]
                 dy = r[9 + b]
                 row = (j0 + b) * nnx + i0
                 for a in range(NA):
                     k = row + a
-                    f = vfld[p, b * NA + a]
                     s = r[a] * sy
-                    ax += s * ga[f, 0, k]
-                    ay += s * ga[f, 1, k]
-                    vnx = gvn[f, 0, k]
-                    vny = gvn[f, 1, k]
+                    if cp_:
+                        f = vfld[p, b * NA + a]
+                        ax += s * ga[f, 0, k]
+                        ay += s * ga[f, 1, k]
+                        vnx = gvn[f, 0, k]
+                        vny = gvn[f, 1, k]
+                    else:
+                        ax += s * ga0[0, k]
+                        ay += s * ga0[1, k]
+                        vnx = gvn0[0, k]
+                        vny = gvn0[1, k]
                     vx += s * vnx
                     vy += s * vny
                     if dt_stress > 0.0:
@@ -837,8 +922,8 @@ def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, ma
                     bad[c, 1] = STATUS_RUNAWAY
             _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
             conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
-                                          nnx, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
-                                          clast, cext0, cext1, ccrack, nslot, nf,
+                                          cut, nnx, ncx, ncy, cstart, chords, cnear, cpx, cpy,
+                                          cfirst, clast, cext0, cext1, ccrack, nslot, nf,
                                           use_position, conflicts)
         counts[c] = conflicts
 
@@ -858,7 +943,15 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
     cstart, chords = cell_segments(cp[0], cp[1], cfirst, clast, cext0, cext1, ccrack, geom,
                                    ncx, ncy)
     node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot)
-    return cstart, chords, np.flatnonzero(nslot[0] >= 0)
+    cnear = np.zeros(ncx * ncy, dtype=np.uint8)
+    for j in range(ncy):
+        for i in range(ncx):
+            cell = j * ncx + i
+            if cstart[cell + 1] > cstart[cell]:
+                for jj in range(max(j - NEAR_CELLS, 0), min(j + NEAR_CELLS + 1, ncy)):
+                    for ii in range(max(i - NEAR_CELLS, 0), min(i + NEAR_CELLS + 1, ncx)):
+                        cnear[jj * ncx + ii] = 1
+    return cstart, chords, np.flatnonzero(nslot[0] >= 0), cnear
 
 
 @njit(cache=True, error_model="numpy")
@@ -869,7 +962,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
-            law1, law2, thickness, use_position, cutoff_cells, vfld, wij, wc, nslot, counts,
+            law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, counts,
             chunk_counts):
     """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
 
@@ -899,10 +992,10 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     dt_update = 0.0 if post_extrapolate else dt_last
     cpx = cp[0]
     cpy = cp[1]
-    cstart, chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
-                                 nslot)
-    weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, gbuf, nch, ncx, ncy,
-                     cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+    cstart, chords, cnodes, cnear = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom,
+                                                ncx, ncy, nnx, nslot)
+    weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
+                     cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
                      g.shape[0], use_position, chunk_counts)
     for c in range(nch):
         counts[C_CONFLICT] += chunk_counts[c]
@@ -915,19 +1008,19 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         rec_force[:] = 0.0
         g[:, GFX] = 0.0
         g[:, GFY] = 0.0
-        scatter_loads(pos, F, geom, g, wij, wc, vfld, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+        scatter_loads(pos, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_rec,
                       rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
         stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, geom, wij,
-                     wc, vfld, gv, gbuf, nch, pending, dt_first, True, n)
+                     wc, vfld, cut, gv, gbuf, nch, pending, dt_first, True, n)
         pending = 0.0
-        reduce_forces(gbuf, g, nch)
+        reduce_forces(gbuf, g, nch, cnodes)
         crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
                         cext1, ccrack, nslot, claw, cstate, chist, law1, law2, thickness,
                         counts)
         contact(g, gv, nslot, cnodes, dt, True, use_position, cutoff_cells, geom)
-        accelerations(g, ga, gvn, dt)
+        accelerations(g, ga, gvn, dt, cnodes)
         velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec,
                                   rec_style, rec_value, rec_t0, rec_ftime, rec_force,
                                   rec_work, sym_out, sym_in, sym_dir, t, dt)
@@ -935,17 +1028,19 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
         if out >= 0:
             return step + 1, STATUS_CRACK_LEFT_GRID, out
-        cstart, chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
-                                     nnx, nslot)
+        old_cnodes = cnodes
+        cstart, chords, cnodes, cnear = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack,
+                                                    geom, ncx, ncy, nnx, nslot)
         update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                                plane_stress, geom, ga, gvn, dt, dt_update, damping, pdamp,
-                               bounds, vmax, left, bad, wij, wc, vfld, gbuf, nch, ncx, ncy,
-                               cstart, chords, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
-                               nslot, use_position, chunk_counts)
+                               bounds, vmax, left, bad, wij, wc, vfld, cut, gbuf, nch, ncx,
+                               ncy, cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0,
+                               cext1, ccrack, nslot, use_position, chunk_counts)
         for c in range(nch):
             counts[C_CONFLICT] += chunk_counts[c]
         _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
         t += dt
+        clear_crack_nodes(g, gv, ga, gvn, old_cnodes)
         reduce_extrapolation(gbuf, g, gv, nch, cnodes)
         contact(g, gv, nslot, cnodes, dt, False, use_position, cutoff_cells, geom)
         momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
@@ -973,7 +1068,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         if status != STATUS_OK or step == nsteps - 1:
             if pending > 0.0:
                 stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
-                             geom, wij, wc, vfld, gv, gbuf, nch, 0.0, pending, False, n)
+                             geom, wij, wc, vfld, cut, gv, gbuf, nch, 0.0, pending, False, n)
             if status != STATUS_OK:
                 return step + 1, status, who
     return nsteps, STATUS_OK, -1

@@ -50,7 +50,7 @@ def tri(ax, ay, bx, by, cx, cy):
     return ax * (by - cy) + bx * (cy - ay) + cx * (ay - by)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def segment_crossing_side(px, py, nx, ny, x3, y3, x4, y4):
     """Crossing of the particle (p) -> node (n) line with one crack chord s3 -> s4.
 

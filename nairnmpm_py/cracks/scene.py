@@ -86,6 +86,7 @@ class CrackScene:
         self.ga = np.zeros((self.nf, 2, nn))
         self.gvn = np.zeros((self.nf, 2, nn))
         self.vfld = np.zeros((n, na * na), dtype=np.int8)
+        self.cut = np.zeros(n, dtype=np.int8)
         self.wij = np.zeros((n, 2), dtype=np.int64)
         self.wc = np.zeros((n, 12))
         self.nslot = np.full((2, nn), -1, dtype=np.int64)
@@ -114,7 +115,7 @@ class CrackScene:
             sim.bad, sim.nch, cs.plane, cs.above, cs.below, self.cfirst, self.clast,
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
             self.law1, self.law2, float(sim.grid.thickness), use_position,
-            float(self.contact_position or 0.0), self.vfld, self.wij, self.wc, self.nslot,
+            float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
             self.counts, self.chunk_counts)
 
     # ---- zone and traction work -------------------------------------------------------
