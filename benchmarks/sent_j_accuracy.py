@@ -154,6 +154,8 @@ def main() -> None:
     ap.add_argument("--shapes", nargs="+", default=["linear", "uGIMP"])
     ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS)
     ap.add_argument("--out", default=str(HERE / "results"))
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the rows already in the CSV for shapes not run now")
     args = ap.parse_args()
     numba.set_num_threads(args.threads)
     out = Path(args.out)
@@ -162,6 +164,17 @@ def main() -> None:
     work.mkdir(exist_ok=True)
     rows = []
     csv_path = out / "sent_j_accuracy.csv"
+    if args.keep and csv_path.exists():
+        with open(csv_path) as f:
+            for r in csv.DictReader(f):
+                if r["shape"] not in args.shapes:
+                    for key in ("cell_mm", "wall_s", "J_J_m2", "J0_J_m2", "error_pct",
+                                "kinetic_over_strain"):
+                        r[key] = float(r[key])
+                    for key in ("particles", "steps", "contour_cells"):
+                        r[key] = int(r[key])
+                    r["inside_specimen"] = r["inside_specimen"] == "True"
+                    rows.append(r)
     for shape in args.shapes:
         for cell in args.cells:
             rows += run_case(cell, shape == "uGIMP", work)

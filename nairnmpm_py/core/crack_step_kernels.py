@@ -963,7 +963,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
             law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, counts,
-            chunk_counts):
+            chunk_counts, resume, flush, pend):
     """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
 
     Order per step: loads and internal forces into each particle's fields; crack
@@ -971,14 +971,17 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     updated and extrapolated to the next step's fields (crossing the moved cracks);
     contact on the new momenta; velocity conditions.  Returns (steps done, status,
     offending particle or crack particle).
+
+    ``resume``: the previous call's last extrapolation is still current (no crack grew,
+    nothing changed), so it is not redone.  ``flush``: apply the carried USAVG+ / USL+
+    stress half at the end (needed before stresses or energies are read); otherwise it
+    is kept in ``pend`` for the next call.
     """
     n = pos.shape[1]
     nn = g.shape[2]
     nnx = int(geom[4])
     ncx = nnx - 1
     ncy = nn // nnx - 1
-    pload = np.zeros(pbc_part.size)
-    pos_before = np.zeros(pbc_part.size)
     if method == USF:
         dt_first = dt
         dt_last = 0.0
@@ -994,6 +997,20 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     cpy = cp[1]
     cstart, chords, cnodes, cnear = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom,
                                                 ncx, ncy, nnx, nslot)
+    pending = pend[0]
+    pend[0] = 0.0
+    if resume:
+        # the previous call ended with this state's extrapolation (nothing changed since)
+        return _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush,
+                          pend, plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress,
+                          hist, w, pdamp, mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp,
+                          damping, vmax, left, leave_limit, gbc_node, gbc_dir, gbc_rec,
+                          pbc_part, pbc_dir, pbc_scale, pbc_rec, rec_style, rec_value, rec_t0,
+                          rec_ftime, rec_force, rec_work, sym_out, sym_in, sym_dir, bad, nch,
+                          cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate,
+                          chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut,
+                          wij, wc, nslot, counts, chunk_counts, cstart, chords, cnodes, cnear,
+                          ncx, ncy, nnx, n)
     weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
                      cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
                      g.shape[0], use_position, chunk_counts)
@@ -1003,7 +1020,32 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     contact(g, gv, nslot, cnodes, dt, False, use_position, cutoff_cells, geom)
     momentum_conditions(g, gv, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
                         rec_ftime, sym_out, sym_in, sym_dir, t)
-    pending = 0.0
+    return _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush, pend,
+                      plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w,
+                      pdamp, mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax,
+                      left, leave_limit, gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir,
+                      pbc_scale, pbc_rec, rec_style, rec_value, rec_t0, rec_ftime, rec_force,
+                      rec_work, sym_out, sym_in, sym_dir, bad, nch, cp, ca, cb, cfirst, clast,
+                      cext0, cext1, ccrack, cfixed, claw, cstate, chist, law1, law2, thickness,
+                      use_position, cutoff_cells, vfld, cut, wij, wc, nslot, counts,
+                      chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx, n)
+
+
+@njit(cache=True, error_model="numpy")
+def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush, pend,
+               plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp,
+               mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax, left,
+               leave_limit, gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+               rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work, sym_out, sym_in,
+               sym_dir, bad, nch, cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw,
+               cstate, chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij,
+               wc, nslot, counts, chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx, n):
+    """The steps themselves, from a current extrapolation.  Without ``flush`` the last
+    step's carried USAVG+ stress half is returned in ``pend`` instead of applied."""
+    pload = np.zeros(pbc_part.size)
+    pos_before = np.zeros(pbc_part.size)
+    cpx = cp[0]
+    cpy = cp[1]
     for step in range(nsteps):
         rec_force[:] = 0.0
         g[:, GFX] = 0.0
@@ -1066,7 +1108,9 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                     who = bad[c, 3]
                     break
         if status != STATUS_OK or step == nsteps - 1:
-            if pending > 0.0:
+            if pending > 0.0 and not flush and status == STATUS_OK:
+                pend[0] = pending
+            elif pending > 0.0:
                 stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
                              geom, wij, wc, vfld, cut, gv, gbuf, nch, 0.0, pending, False, n)
             if status != STATUS_OK:

@@ -84,10 +84,14 @@ class Simulation:
 
     @property
     def dt(self) -> float:
+        cached = getattr(self, "_dt", None)
+        if self.kernels is not None and cached is not None:   # fixed once prepared
+            return cached
+        return self._uncached_dt()
+
+    def _uncached_dt(self) -> float:
         limit = self.cfl_time_step()
-        if self.time_step is not None:
-            return min(self.time_step, limit)
-        return limit
+        return min(self.time_step, limit) if self.time_step is not None else limit
 
     @property
     def n_steps(self) -> int:
@@ -183,6 +187,7 @@ class Simulation:
         speeds = [self.max_wave_speed(), float(np.max(np.abs(p.vel))) if p.n else 0.0]
         speeds += [abs(r.value) for r in self.conditions.records if r.kind == GRID_VELOCITY]
         self.vmax = 20.0 * max(speeds)
+        self._dt = self._uncached_dt()
         if self.cracks is not None:
             self.cracks.prepare(self)
 
@@ -231,8 +236,10 @@ class Simulation:
                 np.array([k[1] for k in keep], dtype=np.int64),
                 np.array([k[2] for k in keep], dtype=np.int64))
 
-    def advance(self, nsteps: int) -> None:
-        """Advance ``nsteps`` steps; raises SimulationUnstable if the run blows up."""
+    def advance(self, nsteps: int, flush: bool = True) -> None:
+        """Advance ``nsteps`` steps; raises SimulationUnstable if the run blows up.
+        ``flush=False`` (scenes with cracks) may leave the last USAVG+ stress half for
+        the next call: stresses and energies are then half a step behind until it."""
         self.prepare()
         p = self.particles
         c = self.cond_arrays
@@ -241,7 +248,7 @@ class Simulation:
             numba.set_num_threads(1)  # one chunk: no thread pool, no barriers
         try:
             if self.cracks is not None:
-                done, status, bad = self.cracks.advance(self, nsteps)
+                done, status, bad = self.cracks.advance(self, nsteps, flush)
             else:
                 done, status, bad = self.kernels.advance(
                     nsteps, self.time, self.dt, self.method, self.post_extrapolate,
@@ -300,11 +307,24 @@ class Simulation:
             self._emit(outputs, archive=True, glob=True)
             chunk = 20
             start_run = wallclock.perf_counter()
+            scene = self.cracks
+            growing = scene is not None and scene.growing
             while self.step < total:
                 target = min(step_at(next_arch), step_at(next_glob), total, self.step + chunk)
+                if growing:   # stop at every propagation check
+                    target = min(target, (self.step // scene.check_steps + 1) * scene.check_steps)
                 target = max(target, self.step + 1)
                 t0 = wallclock.perf_counter()
-                self.advance(target - self.step)
+                emits = (target >= total or target >= step_at(next_arch)
+                         or target >= step_at(next_glob))
+                self.advance(target - self.step, flush=emits)
+                if growing and self.step % scene.check_steps == 0:
+                    grown = scene.propagate(self)
+                    if grown:
+                        for o in outputs:
+                            hook = getattr(o, "on_crack_growth", None)
+                            if hook is not None:
+                                hook(self, grown)
                 spent = wallclock.perf_counter() - t0
                 # aim at about 0.2 s between returns to Python (progress, Ctrl-C)
                 chunk = int(min(max(chunk * (0.2 / max(spent, 1e-4)), 1), 100000))

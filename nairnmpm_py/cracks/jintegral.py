@@ -379,28 +379,39 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
     # one edge only ((0, 1] along the walk), so nothing is counted twice or lost to
     # rounding.
     P = cracks.plane
+    # only chords whose bounding box meets the contour's can cross it
+    lo_x, hi_x, lo_y, hi_y = xs.min(), xs.max(), ys.min(), ys.max()
+    near = []
+    for c in range(cracks.n_cracks):
+        k0, kn = int(cracks.first[c]), int(cracks.count[c])
+        a, b = P[:, k0:k0 + kn - 1], P[:, k0 + 1:k0 + kn]
+        meet = ((np.maximum(a[0], b[0]) >= lo_x) & (np.minimum(a[0], b[0]) <= hi_x)
+                & (np.maximum(a[1], b[1]) >= lo_y) & (np.minimum(a[1], b[1]) <= hi_y))
+        # a chord with both ends strictly inside the square cannot cross its edges
+        inside = ((np.minimum(a[0], b[0]) > lo_x) & (np.maximum(a[0], b[0]) < hi_x)
+                  & (np.minimum(a[1], b[1]) > lo_y) & (np.maximum(a[1], b[1]) < hi_y))
+        meet &= ~inside
+        near += [(c, k0 + int(i)) for i in np.flatnonzero(meet)]
     hits = []   # (edge, t along edge, crack, chord start particle k, u along chord)
     for e in range(len(path) - 1):
         ax, ay, bx, by = xs[e], ys[e], xs[e + 1], ys[e + 1]
-        for c in range(cracks.n_cracks):
-            k0 = int(cracks.first[c])
-            for k in range(k0, k0 + int(cracks.count[c]) - 1):
-                cx0, cy0, cx1, cy1 = P[0, k], P[1, k], P[0, k + 1], P[1, k + 1]
-                if (max(cx0, cx1) < min(ax, bx) or min(cx0, cx1) > max(ax, bx)
-                        or max(cy0, cy1) < min(ay, by) or min(cy0, cy1) > max(ay, by)):
-                    continue
-                if collinear_overlap(ax, ay, bx, by, cx0, cy0, cx1, cy1, 1e-12 * (hx + hy)):
-                    raise ValueError(f"crack {c} runs along a J-contour edge near "
-                                     f"({ax:g}, {ay:g}); keep cracks off grid lines")
-                a1 = tri(ax, ay, bx, by, cx0, cy0)
-                a2 = tri(ax, ay, bx, by, cx1, cy1)
-                if (a1 < 0.0) == (a2 < 0.0):
-                    continue                    # chord does not straddle the edge line
-                b1 = tri(cx0, cy0, cx1, cy1, ax, ay)
-                b2 = tri(cx0, cy0, cx1, cy1, bx, by)
-                if not ((b1 < 0.0 and b2 >= 0.0) or (b1 > 0.0 and b2 <= 0.0)):
-                    continue                    # edge does not straddle the chord line
-                hits.append((e, b1 / (b1 - b2), c, k, a1 / (a1 - a2)))
+        for c, k in near:
+            cx0, cy0, cx1, cy1 = P[0, k], P[1, k], P[0, k + 1], P[1, k + 1]
+            if (max(cx0, cx1) < min(ax, bx) or min(cx0, cx1) > max(ax, bx)
+                    or max(cy0, cy1) < min(ay, by) or min(cy0, cy1) > max(ay, by)):
+                continue
+            if collinear_overlap(ax, ay, bx, by, cx0, cy0, cx1, cy1, 1e-12 * (hx + hy)):
+                raise ValueError(f"crack {c} runs along a J-contour edge near "
+                                 f"({ax:g}, {ay:g}); keep cracks off grid lines")
+            a1 = tri(ax, ay, bx, by, cx0, cy0)
+            a2 = tri(ax, ay, bx, by, cx1, cy1)
+            if (a1 < 0.0) == (a2 < 0.0):
+                continue                    # chord does not straddle the edge line
+            b1 = tri(cx0, cy0, cx1, cy1, ax, ay)
+            b2 = tri(cx0, cy0, cx1, cy1, bx, by)
+            if not ((b1 < 0.0 and b2 >= 0.0) or (b1 > 0.0 and b2 <= 0.0)):
+                continue                    # edge does not straddle the chord line
+            hits.append((e, b1 / (b1 - b2), c, k, a1 / (a1 - a2)))
     others = [h for h in hits if h[2] != crack_index]
     if others:
         raise ValueError(f"crack {others[0][2]} crosses the J contour of crack "

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -34,6 +35,10 @@ class Tip:
     crack: int          # 0-based crack index
     end: str            # 'start' or 'end'
     material: int       # 0-based material index of the tip (for K); -1 unknown
+    criterion: object = None   # propagation-criterion plugin instance, None = no growth
+    new_law: int = -1          # traction law (material index) of new crack particles
+    grown: int = 0             # growth steps so far
+    stopped: str = ""          # why the tip stopped growing for good
 
 
 @dataclass
@@ -44,17 +49,20 @@ class CrackScene:
     jcontour_size: int = 2
     contact_position: float | None = None   # ContactPosition (cells) or None
     jcontour_sizes: list = field(default_factory=list)   # extra sizes for jcontours.csv
-    jcontour_time: float | None = None                   # ms
+    propagate_length: float = 0.5                        # cells per growth step
 
     def __post_init__(self):
         cs = self.cracks
         nc = cs.plane.shape[1]
         self.state = np.where(cs.law >= 0, ACTIVE, INTACT).astype(np.int8)
         self.hist = np.zeros((2, nc))
+        self.pid = np.arange(nc)          # identity of each crack particle (kept on growth)
         self.counts = np.zeros(4, dtype=np.int64)
         self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
-        self.initial_root = {(t.crack, t.end): self.zone(t)[1] for t in self.tips}
+        self.initial_root = {(t.crack, t.end): int(self.pid[self.zone(t)[1]]) for t in self.tips}
         self.kernels = None
+        self.check_steps = 1
+        self.growth_log: list[dict] = []
 
     # ---- kernel side ---------------------------------------------------------------
     def prepare(self, sim) -> None:
@@ -91,6 +99,16 @@ class CrackScene:
         self.wc = np.zeros((n, 12))
         self.nslot = np.full((2, nn), -1, dtype=np.int64)
         self.chunk_counts = np.zeros(sim.nch, dtype=np.int64)
+        self._kernel_arrays()
+        self.grid_current = False      # the next call must extrapolate
+        self.pend = np.zeros(1)        # USAVG+ stress half carried between calls
+        if self.growing:
+            # NairnMPM checks for growth every CFL * cell / wave speed (at least a step)
+            prop_time = 0.5 * min(sim.grid.dx, sim.grid.dy) / sim.max_wave_speed()
+            self.check_steps = max(1, int(prop_time / sim.dt + 1e-9))
+
+    def _kernel_arrays(self) -> None:
+        cs = self.cracks
         self.cfirst = np.ascontiguousarray(cs.first, dtype=np.int64)
         self.clast = np.ascontiguousarray(cs.first + cs.count - 1, dtype=np.int64)
         self.cext0 = np.ascontiguousarray(cs.tips[:, 0] == EXTERIOR_END)
@@ -99,8 +117,14 @@ class CrackScene:
         self.cfixed = np.ascontiguousarray(cs.fixed, dtype=np.bool_)
         self.claw = np.ascontiguousarray(cs.law, dtype=np.int64)
 
-    def advance(self, sim, nsteps: int):
+    @property
+    def growing(self) -> bool:
+        return any(t.criterion is not None for t in self.tips)
+
+    def advance(self, sim, nsteps: int, flush: bool = True):
         p = sim.particles
+        resume = self.grid_current
+        self.grid_current = True
         c = sim.cond_arrays
         cs = self.cracks
         use_position = self.contact_position is not None
@@ -116,7 +140,7 @@ class CrackScene:
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
             self.law1, self.law2, float(sim.grid.thickness), use_position,
             float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
-            self.counts, self.chunk_counts)
+            self.counts, self.chunk_counts, resume, flush, self.pend)
 
     # ---- zone and traction work -------------------------------------------------------
     def _tip_point(self, tip: Tip) -> np.ndarray:
@@ -188,15 +212,33 @@ class CrackScene:
         return float(-t[1] * d[0] + t[0] * d[1]), float(t[0] * d[0] + t[1] * d[1])
 
     # ---- J at the tips ------------------------------------------------------------------
-    def tip_results(self, sim, sizes=None) -> list[dict]:
+    def tip_results(self, sim, sizes=None, tips=None) -> list[dict]:
         """One dict per tip (per contour size when ``sizes`` is given) with the
         cracks.csv columns."""
-        fields = nodal_fields(sim.grid, sim.particles, self.cracks, sim.shape, strict=False)
+        tips = self.tips if tips is None else tips
+        sizes = list(sizes or [self.jcontour_size])
+        if not tips:
+            return []
+        fields = nodal_fields(sim.grid, self._near_tips(sim, tips, max(sizes)), self.cracks,
+                              sim.shape, strict=False)
         rows = []
-        for tip in self.tips:
-            for size in (sizes or [self.jcontour_size]):
+        for tip in tips:
+            for size in sizes:
                 rows.append(self._tip_row(sim, fields, tip, int(size)))
         return rows
+
+    def _near_tips(self, sim, tips, size: int):
+        """The particles that reach the nodes of contours of half-size ``size`` cells
+        around these tips (J needs nodal values on the contour only)."""
+        p = sim.particles
+        reach = (size + 3) * max(sim.grid.dx, sim.grid.dy)
+        keep = np.zeros(p.n, dtype=bool)
+        for tip in tips:
+            x, y = self._tip_point(tip)
+            keep |= (np.abs(p.pos[0] - x) <= reach) & (np.abs(p.pos[1] - y) <= reach)
+        return SimpleNamespace(**{name: np.ascontiguousarray(getattr(p, name)[..., keep])
+                                  for name in ("pos", "vel", "mass", "vol0", "lp", "F",
+                                               "stress", "w")})
 
     def _tip_row(self, sim, fields, tip: Tip, size: int) -> dict:
         cs = self.cracks
@@ -216,8 +258,9 @@ class CrackScene:
                "W_B_crossing_J_m2": math.nan,
                "W_B_root_J_m2": w_root, "W_B_rec_root_J_m2": w_rec, "R_J_m2": math.nan,
                "cod_root_mm": self.cod_at(root)[0],
-               "cod_notch0_mm": self.cod_at(self.initial_root[key])[0],
-               "KI_MPa_sqrt_m": math.nan, "KII_MPa_sqrt_m": math.nan, "error": ""}
+               "cod_notch0_mm": self.cod_at(self._index_of(self.initial_root[key]))[0],
+               "KI_MPa_sqrt_m": math.nan, "KII_MPa_sqrt_m": math.nan, "event": "archive",
+               "error": ""}
         try:
             res = j_integral(sim.grid, fields, cs, tip.crack, tip.end, size)
         except ValueError as exc:
@@ -240,6 +283,10 @@ class CrackScene:
             j_ff = j_tip + w_root
         row.update({"J_contour_J_m2": j_x, "J_tip_J_m2": j_tip, "J_ff_J_m2": j_ff,
                     "W_B_crossing_J_m2": w_cross})
+        if tip.criterion is not None and tip.grown > 0:
+            # Eq 15: the energy released per unit growth
+            jc = tip.criterion.critical_J(sim.materials[tip.material])
+            row["R_J_m2"] = jc + w_root - w_rec
         if tip.material >= 0:
             consts = sim.materials[tip.material].shear_and_poisson()
             if consts is not None:
@@ -250,6 +297,64 @@ class CrackScene:
                 row["KII_MPa_sqrt_m"] = to_mpa_sqrt_m(k2)
         return row
 
+    def _index_of(self, pid: int) -> int:
+        return int(np.flatnonzero(self.pid == pid)[0])
+
     def _beyond_root(self, tip: Tip, k: int, zone: list[int]) -> bool:
         walk = list(self._walk(tip))
         return walk.index(k) > walk.index(zone[-1])
+
+    # ---- propagation ------------------------------------------------------------------
+    def propagate(self, sim) -> list[dict]:
+        """Check every growing tip once (seed section 4, steps 2-3); grow those whose
+        criterion says so by one step.  Returns the cracks.csv rows of the tips that
+        grew, taken just before they grew (J_tip at growth, R by Eq 15)."""
+        tips = [t for t in self.tips if t.criterion is not None and not t.stopped]
+        if not tips:
+            return []
+        rows = []
+        for tip, row in zip(tips, self.tip_results(sim, tips=tips)):
+            if row["error"]:
+                continue
+            material = sim.materials[tip.material]
+            if not tip.criterion.should_grow(row, material):
+                continue
+            tip.grown += 1
+            jc = tip.criterion.critical_J(material)
+            row["R_J_m2"] = jc + row["W_B_root_J_m2"] - row["W_B_rec_root_J_m2"]
+            row["event"] = "growth"
+            if self._grow(sim, tip):
+                rows.append(row)
+        self.growth_log += rows
+        return rows
+
+    def _grow(self, sim, tip: Tip) -> bool:
+        """Add one crack particle ahead of the tip: PropagateLength cells along the tip
+        direction (self-similar growth), with the crack's new-particle traction law,
+        zero opening and fresh history.  False (and the tip stops) if it would leave
+        the grid."""
+        from .jintegral import crack_tip
+        cs = self.cracks
+        k_tip, _, d = crack_tip(cs, tip.crack, tip.end)
+        g = sim.grid
+        h = g.dx if abs(d[0]) > abs(d[1]) else g.dy
+        new = cs.plane[:, k_tip] + self.propagate_length * h * d
+        if not (g.xmin < new[0] < g.xmax and g.ymin < new[1] < g.ymax):
+            tip.stopped = "the next crack particle would leave the grid"
+            return False
+        at = k_tip + 1 if tip.end == "end" else k_tip
+        col = new.reshape(2, 1)
+        cs.plane = np.ascontiguousarray(np.insert(cs.plane, [at], col, axis=1))
+        cs.above = np.ascontiguousarray(np.insert(cs.above, [at], col, axis=1))
+        cs.below = np.ascontiguousarray(np.insert(cs.below, [at], col, axis=1))
+        cs.crack = np.insert(cs.crack, at, tip.crack)
+        cs.law = np.insert(cs.law, at, tip.new_law)
+        cs.count[tip.crack] += 1
+        cs.first[tip.crack + 1:] += 1
+        self.state = np.ascontiguousarray(
+            np.insert(self.state, at, ACTIVE if tip.new_law >= 0 else INTACT)).astype(np.int8)
+        self.hist = np.ascontiguousarray(np.insert(self.hist, [at], 0.0, axis=1))
+        self.pid = np.insert(self.pid, at, self.pid.max() + 1)
+        self._kernel_arrays()
+        self.grid_current = False
+        return True

@@ -134,6 +134,47 @@ def _crack_material(r: Reader, model: InputModel, names: list, number, name, whe
     return idx
 
 
+def _tip_propagation(r: Reader, model: InputModel, materials: list, names: list, tip,
+                     tprop, used: dict, line) -> None:
+    """The tip's propagation criterion, direction and new-particle traction law: the
+    tip material's <Propagate> if it has one, else the first <Cracks><Propagate>; the
+    crack's Tprop overrides the criterion's traction law (NairnMPM's rules)."""
+    mm = model.materials[tip.material]
+    header = model.mpm.cracks
+    if mm.propagate is not None:
+        criterion, direction, traction, where = mm.propagate
+    elif header is not None and header.propagate:
+        (criterion, direction, traction), where = header.propagate[0], header.line
+    else:
+        return
+    where = where or line
+    info = plugins.resolve("propagation", criterion)
+    if info is None:
+        known = ", ".join(f"{p.name} ({p.nairn_type})" for p in plugins.registry("propagation"))
+        r.problem(_at(where), f"<Propagate criterion=\"{criterion}\">: no propagation criterion "
+                              f"of that number (installed: {known})")
+        return
+    if info.nairn_type == 0:
+        return
+    if direction not in (0, 1):
+        r.problem(_at(where), f"<Propagate direction=\"{direction}\">: only 0 and 1 (straight "
+                              "ahead, along the crack-tip direction) are supported")
+        return
+    crit = info.cls()
+    missing = crit.check(materials[tip.material])
+    if missing:
+        r.problem(_at(where), missing)
+        return
+    law = tprop
+    if law is None and traction and traction > 0:
+        law = _crack_material(r, model, names, traction, None, where, "traction_laws",
+                              "<Propagate traction>")
+    if law is not None:
+        used[law] = materials[law]
+    tip.criterion = crit
+    tip.new_law = -1 if law is None else law
+
+
 def _crack_scene(r: Reader, model: InputModel, materials: list, names: list):
     """The scene's cracks (None without any): crack particles, their traction laws
     and the tips that get J."""
@@ -153,16 +194,25 @@ def _crack_scene(r: Reader, model: InputModel, materials: list, names: list):
         ends = (crack.points[0].tip, crack.points[-1].tip)
         tips.append(ends)
         fixed.append(crack.fixed)
+        tprop = _crack_material(r, model, names, crack.tprop, crack.tpropname, crack.line,
+                                "traction_laws", "<CrackList> Tprop")
+        if tprop is not None:
+            used[tprop] = materials[tprop]
         for end, code, p in (("start", ends[0], crack.points[0]), ("end", ends[1], crack.points[-1])):
             if code > 0:
                 idx = _crack_material(r, model, names, code, None, p.line or crack.line,
                                       "materials", "crack tip material")
-                tip_list.append(Tip(c, end, -1 if idx is None else idx))
+                tip = Tip(c, end, -1 if idx is None else idx)
+                if idx is not None:
+                    _tip_propagation(r, model, materials, names, tip, tprop, used,
+                                     p.line or crack.line)
+                tip_list.append(tip)
     h = model.mpm.cracks
     return CrackScene(CrackSet.from_polylines(polylines, laws, tips, fixed), used, tip_list,
                       jcontour_size=h.jcontour_size if h else 2,
                       contact_position=h.contact_position if h else None,
-                      jcontour_sizes=list(h.jcontour_sizes) if h else [])
+                      jcontour_sizes=list(h.jcontour_sizes) if h else [],
+                      propagate_length=h.propagate_length if h else 0.5)
 
 
 # ---- particles ----------------------------------------------------------------------

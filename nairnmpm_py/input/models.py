@@ -97,6 +97,7 @@ class MaterialModel(Model):
     name: str
     params: dict
     pdamping_per_s: float | None = None
+    propagate: tuple[int, int, int, int | None] | None = None  # criterion, direction, traction, line
 
 
 class ConditionModel(Model):

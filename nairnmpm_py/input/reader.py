@@ -311,7 +311,7 @@ def _body(r: Reader, el) -> BodyModel | None:
 
 
 # ---- Material -------------------------------------------------------------------
-COMMON_MATERIAL_CHILDREN = {"PDamping", "color"}
+COMMON_MATERIAL_CHILDREN = {"PDamping", "color", "Propagate"}
 
 
 def _material(r: Reader, el) -> MaterialModel | None:
@@ -334,11 +334,15 @@ def _material(r: Reader, el) -> MaterialModel | None:
         r.problem(el, f"<Material Type=\"{a['Type']}\">: no material or traction-law plugin of "
                       f"that type or name (installed: {known})")
         return None
-    values, lines, pdamp = {}, {}, None
+    values, lines, pdamp, propagate = {}, {}, None, None
     fields = info.cls.Params.model_fields
     for c in r.children(el):
         if c.tag == "PDamping":
             pdamp = r.text(c, float)
+        elif c.tag == "Propagate":
+            p = r.attrs(c, {"criterion": int, "direction": int, "traction": int})
+            propagate = (p.get("criterion", 0), p.get("direction", 0), p.get("traction", 0),
+                         c.sourceline)
         elif c.tag == "color":
             r.attrs(c, {"red": float, "green": float, "blue": float, "alpha": float})
         elif c.tag in fields:
@@ -367,7 +371,8 @@ def _material(r: Reader, el) -> MaterialModel | None:
             r.problem(_Line(where) if where else el, msg)
         return None
     return MaterialModel(type=info.nairn_type, plugin=info.name, group=group, name=a.get("Name", ""),
-                         params=params.model_dump(), pdamping_per_s=pdamp, line=el.sourceline)
+                         params=params.model_dump(), pdamping_per_s=pdamp, propagate=propagate,
+                         line=el.sourceline)
 
 
 class _Line:

@@ -29,6 +29,11 @@ from pydantic import BaseModel, ConfigDict
 class MaterialParams(BaseModel):
     model_config = ConfigDict(extra="forbid")
     rho: float  # g/cm^3 as NairnMPM reads it
+    # fracture properties, used by propagation criteria when the material is a crack tip
+    JIc: float | None = None     # J/m^2
+    JIIc: float | None = None    # J/m^2
+    KIc: float | None = None     # MPa sqrt(m)
+    KIIc: float | None = None    # MPa sqrt(m)
 
 
 class MaterialPlugin:

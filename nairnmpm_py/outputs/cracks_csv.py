@@ -4,8 +4,10 @@ contour size an input lists, per tip per archive time).
 Columns are those of DESIGN.md section 3 plus ``contour_cells`` (the half-size of the
 contour used), ``J_contour_J_m2`` (the contour value J(x) itself),
 ``W_B_crossing_J_m2`` (the traction work where the contour crosses the crack) and
-``error`` (why J could not be computed at that tip, e.g. the contour left the grid).
-R (Eq 15) needs the critical J_tip of a propagation criterion and is empty without one.
+``event`` (``archive`` for the rows written at archive times, ``growth`` for the row
+of a tip taken at the check that made it grow) and ``error`` (why J could not be
+computed at that tip, e.g. the contour left the grid).  R (Eq 15) needs the critical
+J_tip of a propagation criterion: it is empty until the tip has grown.
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ COLUMNS = ["time_ms", "crack", "tip", "contour_cells", "tip_x_mm", "tip_y_mm",
            "crack_growth_mm", "root_x_mm", "root_y_mm", "zone_length_mm", "J_contour_J_m2",
            "J_tip_J_m2", "J_ff_J_m2", "W_B_crossing_J_m2", "W_B_root_J_m2",
            "W_B_rec_root_J_m2", "R_J_m2", "cod_root_mm", "cod_notch0_mm", "KI_MPa_sqrt_m",
-           "KII_MPa_sqrt_m", "error"]
+           "KII_MPa_sqrt_m", "event", "error"]
 
 
 def _cell(v) -> str:
@@ -68,6 +70,12 @@ class CracksCsv(OutputPlugin):
         self._tips.write(scene.tip_results(sim))
         if self._contours is not None:
             self._contours.write(scene.tip_results(sim, sizes=scene.jcontour_sizes))
+
+    def on_crack_growth(self, sim, rows: list[dict]) -> None:
+        """Rows of the tips that just grew (``event`` = growth), taken at the check
+        that made them grow."""
+        if self._tips is not None:
+            self._tips.write(rows)
 
     def end(self, sim, status: dict) -> None:
         for f in (self._tips, self._contours):

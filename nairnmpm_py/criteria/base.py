@@ -1,0 +1,32 @@
+"""What a propagation-criterion plugin provides.
+
+A criterion is a class with ``name``, ``nairn_type`` (NairnMPM's criterion number)
+and ``should_grow(tip, material) -> bool``, where ``tip`` is the crack tip's row of
+results (``cracks.csv`` columns: ``J_tip_J_m2``, ``J_ff_J_m2``, ``KI_MPa_sqrt_m``, ...)
+and ``material`` the tip material plugin instance, whose parameters carry the
+fracture properties (``JIc``, ``JIIc`` in J/m^2, ``KIc``, ``KIIc`` in MPa sqrt(m)).
+``critical_J(material)`` gives the J_tip,c the framework uses in R (seed Eq 15).
+
+The framework owns the rest (NairnMPM's rules, shared notes JINTEGRAL.md section 8):
+when to check, the growth direction and length, the new crack particle and the
+traction law it gets, and the energy released.
+"""
+from __future__ import annotations
+
+import math
+
+
+class PropagationCriterion:
+    name = "criterion"
+    nairn_type: int | None = None
+
+    def should_grow(self, tip: dict, material) -> bool:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def critical_J(self, material) -> float:
+        """J_tip,c in J/m^2 (NaN when the criterion has none)."""
+        return math.nan
+
+    def check(self, material) -> str | None:
+        """A message when the tip material lacks what this criterion needs."""
+        return None
