@@ -144,7 +144,7 @@ def _tip_propagation(r: Reader, model: InputModel, materials: list, names: list,
     if mm.propagate is not None:
         criterion, direction, traction, where = mm.propagate
     elif header is not None and header.propagate:
-        (criterion, direction, traction), where = header.propagate[0], header.line
+        criterion, direction, traction, where = header.propagate[0]
     else:
         return
     where = where or line

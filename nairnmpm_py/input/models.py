@@ -28,7 +28,7 @@ class CracksHeaderModel(Model):
     jcontour_sizes: list[int] = []   # ours: sizes (cells) for jcontours.csv
     friction: float = 0.0        # 0 = frictionless (the only kind so far)
     contact_position: float | None = None
-    propagate: list[tuple[int, int, int]] = []   # (criterion, direction, traction)
+    propagate: list[tuple[int, int, int, int | None]] = []   # criterion, direction, traction, line
     propagate_length: float = 0.5
 
 

@@ -509,7 +509,7 @@ def _cracks_header(r: Reader, el) -> CracksHeaderModel:
         elif c.tag == "Propagate":
             a = r.attrs(c, {"criterion": int, "direction": int, "traction": int})
             h["propagate"].append((a.get("criterion", 0), a.get("direction", 0),
-                                   a.get("traction", 0)))
+                                   a.get("traction", 0), c.sourceline))
         elif c.tag == "PropagateLength":
             r.attrs(c, {})
             v = r.text(c, float)
