@@ -178,7 +178,7 @@ def _plot_cracks(c: dict, out: Path, written: list[Path]) -> None:
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
         _save(fig, out / "j_vs_time.png", written)
-    if "crack_growth_mm" in c and "R_J_m2" in c:
+    if "crack_growth_mm" in c and "R_J_m2" in c and np.any(np.isfinite(c["R_J_m2"])):
         fig, (ax,) = _figure()
         for label, rows in series:
             ax.plot(c["crack_growth_mm"][rows], c["R_J_m2"][rows], label=f"R, {label}")
@@ -189,6 +189,26 @@ def _plot_cracks(c: dict, out: Path, written: list[Path]) -> None:
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
         _save(fig, out / "r_curve.png", written)
+    if "cod_notch0_mm" in c and "R_J_m2" in c and np.any(np.isfinite(c["R_J_m2"])):
+        # seed Fig 7: R against the opening at the original notch root
+        fig, (ax,) = _figure()
+        for label, rows in series:
+            ok = rows[np.isfinite(c["R_J_m2"][rows])]
+            ax.plot(c["cod_notch0_mm"][ok], c["R_J_m2"][ok], ".-", label=f"R, {label}")
+        ax.set_xlabel("COD at the original notch root (mm)")
+        ax.set_ylabel("R (J/m^2)")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+        _save(fig, out / "r_vs_cod.png", written)
+    if "zone_length_mm" in c and np.any(np.asarray(c["zone_length_mm"]) > 0):
+        fig, (ax,) = _figure()
+        for label, rows in series:
+            ax.plot(t[rows], c["zone_length_mm"][rows], label=label)
+        ax.set_xlabel(TIME_LABEL)
+        ax.set_ylabel("bridging zone length (mm)")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+        _save(fig, out / "zone_length.png", written)
     if "crack_growth_mm" in c:
         fig, (ax,) = _figure()
         for label, rows in series:

@@ -2,6 +2,8 @@
 archive.h5) as numpy arrays."""
 from __future__ import annotations
 
+import csv
+
 import json
 import warnings
 from pathlib import Path
@@ -11,25 +13,23 @@ import numpy as np
 
 
 def read_csv_columns(path: Path) -> tuple[list[str], dict[str, np.ndarray]]:
-    """Columns of a CSV with one header row: numeric columns as float arrays,
-    any other column (e.g. a crack name) as a string array."""
-    path = Path(path)
-    with open(path) as f:
-        header = f.readline().strip()
-    names = [c.strip() for c in header.split(",")] if header else []
-    if not names:
+    """Columns of a CSV with one header row: numeric columns as float arrays (an empty
+    cell is NaN), any other column (e.g. a tip name or an error message, quoted) as a
+    string array."""
+    with open(Path(path), newline="") as f:
+        table = list(csv.reader(f))
+    if not table or not table[0]:
         return [], {}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")   # a header-only file (no rows yet) is fine
-        cells = np.loadtxt(path, delimiter=",", skiprows=1, dtype=str, ndmin=2)
-    if cells.size == 0:
-        return names, {n: np.zeros(0) for n in names}
+    names = [c.strip() for c in table[0]]
+    rows = [r for r in table[1:] if r]
     columns = {}
     for i, n in enumerate(names):
+        cells = [r[i] if i < len(r) else "" for r in rows]
         try:
-            columns[n] = cells[:, i].astype(np.float64)
+            columns[n] = np.array([float(c) if c.strip() else np.nan for c in cells],
+                                  dtype=np.float64)
         except ValueError:
-            columns[n] = cells[:, i]
+            columns[n] = np.array(cells, dtype=str)
     return names, columns
 
 
@@ -71,13 +71,15 @@ class Results:
 
     def archive(self, k: int) -> dict:
         """Archive number k (0 = first, -1 = last): particle arrays, component first,
-        plus ``time_ms`` and ``step``."""
+        plus ``time_ms`` and ``step`` (and ``cracks``, a dict of the crack arrays, in
+        scenes with cracks)."""
         with h5py.File(self.archive_path, "r") as h5:
             keys = self._archive_keys(h5)
             if not keys:
                 raise IndexError(f"{self.archive_path} holds no archives")
             grp = h5["archives"][keys[k]]
-            data = {name: ds[()] for name, ds in grp.items()}
+            data = {name: ({k: v[()] for k, v in ds.items()} if isinstance(ds, h5py.Group)
+                           else ds[()]) for name, ds in grp.items()}
             data["time_ms"] = float(grp.attrs["time_ms"])
             data["step"] = int(grp.attrs["step"])
         return data
