@@ -17,6 +17,7 @@ in the unbroken run of traction-carrying particles that starts at (or next to) t
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -63,6 +64,7 @@ class CrackScene:
         self.kernels = None
         self.check_steps = 1
         self.growth_log: list[dict] = []
+        self.j_conflicts = 0      # J-field particle-node pairs on a crack line (field 0)
 
     # ---- kernel side ---------------------------------------------------------------
     def prepare(self, sim) -> None:
@@ -219,8 +221,12 @@ class CrackScene:
         sizes = list(sizes or [self.jcontour_size])
         if not tips:
             return []
-        fields = nodal_fields(sim.grid, self._near_tips(sim, tips, max(sizes)), self.cracks,
-                              sim.shape, strict=False)
+        with warnings.catch_warnings():
+            # nodes or particles on a crack line: counted, reported in run.json
+            warnings.simplefilter("ignore", RuntimeWarning)
+            fields = nodal_fields(sim.grid, self._near_tips(sim, tips, max(sizes)),
+                                  self.cracks, sim.shape, strict=False)
+        self.j_conflicts += fields.conflicts
         rows = []
         for tip in tips:
             for size in sizes:
@@ -355,6 +361,25 @@ class CrackScene:
             np.insert(self.state, at, ACTIVE if tip.new_law >= 0 else INTACT)).astype(np.int8)
         self.hist = np.ascontiguousarray(np.insert(self.hist, [at], 0.0, axis=1))
         self.pid = np.insert(self.pid, at, self.pid.max() + 1)
+        if tip.grown == 1 and tip.new_law >= 0:
+            # the notch root of the paper is where the bridging zone starts: the first
+            # crack particle grown with a law (the initial tip itself stays traction
+            # free, as in NairnMPM)
+            self.initial_root[(tip.crack, tip.end)] = int(self.pid[at])
         self._kernel_arrays()
         self.grid_current = False
         return True
+
+    def summary(self) -> dict:
+        """Crack counters for run.json."""
+        cs = self.cracks
+        return {"cracks": int(cs.n_cracks), "crack_particles": int(cs.plane.shape[1]),
+                "growth_steps": {f"crack {t.crack + 1} {t.end}": t.grown for t in self.tips},
+                "stopped_tips": {f"crack {t.crack + 1} {t.end}": t.stopped
+                                 for t in self.tips if t.stopped},
+                "failed_traction_particles": int(np.sum(self.state == FAILED)),
+                "propagation_check_steps": int(self.check_steps),
+                "field_conflicts": int(self.counts[0]),
+                "surfaces_without_material": int(self.counts[1]),
+                "blocked_crack_moves": int(self.counts[3]),
+                "j_field_conflicts": int(self.j_conflicts)}

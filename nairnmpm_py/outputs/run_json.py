@@ -65,6 +65,9 @@ class RunJson(OutputPlugin):
         self.info["exit_status"] = status.get("exit_status", "unknown")
         if status.get("message"):
             self.info["message"] = str(status["message"])
+        scene = getattr(sim, "cracks", None)
+        if scene is not None:
+            self.info["cracks"] = scene.summary()
         self._write(sim)
 
     def _write(self, sim) -> None:
