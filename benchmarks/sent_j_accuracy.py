@@ -141,7 +141,8 @@ def plot(rows: list[dict], png: Path) -> None:
     ax.set_yscale("log")
     ax.set_xlabel("wall time (s)")
     ax.set_ylabel("|J / J0 - 1| (%)")
-    ax.set_title("Traction-free SENT: J error against cost (band: contours 2-8 cells inside the specimen)")
+    ax.set_title("Traction-free SENT: J error against cost\n(line: median, band: contours of 2-8 cells inside the specimen)",
+                 fontsize="medium")
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     fig.tight_layout()
@@ -154,6 +155,8 @@ def main() -> None:
     ap.add_argument("--shapes", nargs="+", default=["linear", "uGIMP"])
     ap.add_argument("--threads", type=int, default=numba.config.NUMBA_NUM_THREADS)
     ap.add_argument("--out", default=str(HERE / "results"))
+    ap.add_argument("--plot-only", action="store_true",
+                    help="redraw the PNG from the CSV already written")
     ap.add_argument("--keep", action="store_true",
                     help="keep the rows already in the CSV for shapes not run now")
     args = ap.parse_args()
@@ -164,6 +167,8 @@ def main() -> None:
     work.mkdir(exist_ok=True)
     rows = []
     csv_path = out / "sent_j_accuracy.csv"
+    if args.plot_only:
+        args.keep, args.shapes = True, []
     if args.keep and csv_path.exists():
         with open(csv_path) as f:
             for r in csv.DictReader(f):

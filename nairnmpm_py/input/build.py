@@ -114,8 +114,8 @@ def _crack_material(r: Reader, model: InputModel, names: list, number, name, whe
                     group: str, what: str):
     """0-based index of the material a crack names by number or name, checked to be
     of the expected plugin group; None when none is named or it is wrong."""
-    if number is None and name is None:
-        return None
+    if (number is None or number <= 0) and not name:
+        return None   # NairnMPM: a number <= 0 (or an empty name) means none
     if name is not None:
         if name not in names:
             r.problem(_at(where), f"{what}: no material named '{name}'")
