@@ -33,9 +33,13 @@ def _crack_summary(sim) -> str:
     for c in range(cs.n_cracks):
         s, n = cs.first[c], cs.count[c]
         with_law = int((cs.law[s:s + n] >= 0).sum())
-        tips = [t.end for t in scene.tips if t.crack == c]
-        parts.append(f"crack {c + 1}: {n} particles, {with_law} with traction laws, "
-                     f"J at {' and '.join(tips) + ' tip' if tips else 'no tip'}")
+        tips = [t for t in scene.tips if t.crack == c]
+        where = " and ".join(t.end for t in tips) + " tip" if tips else "no tip"
+        grows = [f"{t.end} tip grows by {t.criterion.name}"
+                 + (f" with law '{sim.material_names[t.new_law]}'" if t.new_law >= 0 else "")
+                 for t in tips if t.criterion is not None]
+        parts.append(f"crack {c + 1}: {n} particles, {with_law} with traction laws, J at "
+                     f"{where}" + ("; " + ", ".join(grows) if grows else ""))
     return "cracks:     " + "; ".join(parts) + f" (J contour {scene.jcontour_size} cells)"
 
 
