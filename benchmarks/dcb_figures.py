@@ -112,6 +112,7 @@ def main() -> None:
               "8A": ("load-line opening (mm)", "moment M (N mm)"),
               "8B": ("crack growth (mm)", "R (J/m^2)"),
               "10": ("moment M (N mm)", "bridging zone length (mm)")}
+    figs["7"][1].set_xlim(0, 3)
     for key, (fig, ax) in figs.items():
         ax.set_xlabel(labels[key][0])
         ax.set_ylabel(labels[key][1])
