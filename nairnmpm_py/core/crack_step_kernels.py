@@ -650,7 +650,7 @@ def crack_frame(k, cpx, cpy, ccrack, cfirst, clast):
 
 @njit(cache=True, inline="always")
 def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
-                   clast, cext0, cext1, ccrack, nslot, nf, nodes, fields, weights, g):
+                   clast, cext0, cext1, ccrack, nslot, nf, nodes, fields, weights, g, tested):
     """Classic linear shape functions at a crack surface point and the field on the
     surface's side at each of the four nodes; weights are S * m of that field (0 when
     the field is empty).  Returns the sum of the weights."""
@@ -674,12 +674,72 @@ def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy
             nodes[q] = node
             fields[q] = 0
             weights[q] = 0.0
+            tested[q] = s > 0.0
             if s > 0.0:
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
                 f, k0, s0, k1, s1, bad = _pair_field(tx_, ty_, xn, yn, node, cell, cstart,
                                                      chords, cpx, cpy, cfirst, clast, cext0,
                                                      cext1, ccrack, nslot, nf)
+                fields[q] = f
+                weights[q] = s * g[f, GM, node]
+                total += weights[q]
+            q += 1
+    return total
+
+
+@njit(cache=True, inline="always")
+def _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
+    """Within 2.5 cells of an end of its crack, where a surface-node line can pass
+    beyond the end, so the two surfaces' fields are not mirror images."""
+    c = ccrack[k]
+    reach = 2.5 * max(geom[2], geom[3])
+    for e in (cfirst[c], clast[c]):
+        dx = cpx[k] - cpx[e]
+        dy = cpy[k] - cpy[e]
+        if dx * dx + dy * dy < reach * reach:
+            return True
+    return False
+
+
+@njit(cache=True, inline="always")
+def _mirror_surface_nodes(sx, sy, geom, crack, nslot, nf, ref_nodes, ref_fields, ref_tested,
+                          nodes, fields, weights, g):
+    """The second surface of a crack particle away from the crack's ends, when it lies
+    in the same cell as the first: each node's field is the first surface's with the
+    bit of this crack's slot flipped (the two surfaces sit on opposite sides of their
+    own crack and, so close together, on the same side of everything else), which
+    saves its crossing tests.
+    Returns -1 when that does not apply (another cell, or a node the first surface
+    did not test)."""
+    nnx = int(geom[4])
+    xi = (sx - geom[0]) / geom[2]
+    eta = (sy - geom[1]) / geom[3]
+    i0 = int(math.floor(xi))
+    j0 = int(math.floor(eta))
+    rx = xi - i0
+    ry = eta - j0
+    total = 0.0
+    q = 0
+    for b in range(2):
+        for a in range(2):
+            s = (rx if a == 1 else 1.0 - rx) * (ry if b == 1 else 1.0 - ry)
+            node = (j0 + b) * nnx + i0 + a
+            if node != ref_nodes[q]:
+                return -1.0
+            nodes[q] = node
+            fields[q] = 0
+            weights[q] = 0.0
+            if s > 0.0:
+                if not ref_tested[q]:
+                    return -1.0
+                f = ref_fields[q]
+                if nslot[0, node] == crack:
+                    f ^= 1
+                elif nslot[1, node] == crack:
+                    f ^= 2
+                if f >= nf:
+                    return -1.0
                 fields[q] = f
                 weights[q] = s * g[f, GM, node]
                 total += weights[q]
@@ -697,6 +757,10 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast
     nodes = np.empty(4, dtype=np.int64)
     fields = np.empty(4, dtype=np.int64)
     weights = np.empty(4)
+    tested = np.empty(4, dtype=np.bool_)
+    ref_nodes = np.empty(4, dtype=np.int64)
+    ref_fields = np.empty(4, dtype=np.int64)
+    ref_tested = np.empty(4, dtype=np.bool_)
     cpx = cp[0]
     cpy = cp[1]
     for k in range(cp.shape[1]):
@@ -741,9 +805,18 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
-                                   cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
-                                   nodes, fields, weights, g)
+            total = -1.0
+            if side == 1 and not _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
+                total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
+                                              ref_fields, ref_tested, nodes, fields, weights, g)
+            if total < 0.0:
+                total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
+                                       cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
+                                       nodes, fields, weights, g, tested)
+                if side == 0:
+                    ref_nodes[:] = nodes
+                    ref_fields[:] = fields
+                    ref_tested[:] = tested
             if total <= 0.0:
                 continue
             for q in range(4):
@@ -765,6 +838,10 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
     nodes = np.empty(4, dtype=np.int64)
     fields = np.empty(4, dtype=np.int64)
     weights = np.empty(4)
+    tested = np.empty(4, dtype=np.bool_)
+    ref_nodes = np.empty(4, dtype=np.int64)
+    ref_fields = np.empty(4, dtype=np.int64)
+    ref_tested = np.empty(4, dtype=np.bool_)
     moves = np.zeros((nc, 2, 2))
     found = np.zeros((nc, 2), dtype=np.bool_)
     limit = 0.5 * min(geom[2], geom[3])
@@ -778,9 +855,18 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
-                                   cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
-                                   nodes, fields, weights, g)
+            total = -1.0
+            if side == 1 and not _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
+                total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
+                                              ref_fields, ref_tested, nodes, fields, weights, g)
+            if total < 0.0:
+                total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
+                                       cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
+                                       nodes, fields, weights, g, tested)
+                if side == 0:
+                    ref_nodes[:] = nodes
+                    ref_fields[:] = fields
+                    ref_tested[:] = tested
             if total <= 0.0:
                 continue
             vx = 0.0
