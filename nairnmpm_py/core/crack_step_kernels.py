@@ -747,6 +747,28 @@ def _mirror_surface_nodes(sx, sy, geom, crack, nslot, nf, ref_nodes, ref_fields,
     return total
 
 
+@njit(cache=True, inline="always")
+def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy,
+                cfirst, clast, cext0, cext1, ccrack, nslot, nf, g, nodes, fields, weights,
+                tested, ref_nodes, ref_fields, ref_tested):
+    """Nodes, fields and weights of one surface of crack particle k: the second surface
+    (side 1) mirrors the first where it can, else both run the crossing tests; the
+    first surface's result is kept in ``ref_*`` for the second."""
+    total = -1.0
+    if side == 1 and not _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
+        total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
+                                      ref_fields, ref_tested, nodes, fields, weights, g)
+    if total < 0.0:
+        total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy,
+                               cfirst, clast, cext0, cext1, ccrack, nslot, nf, nodes, fields,
+                               weights, g, tested)
+        if side == 0:
+            ref_nodes[:] = nodes
+            ref_fields[:] = fields
+            ref_tested[:] = tested
+    return total
+
+
 @njit(cache=True, error_model="numpy")
 def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0, cext1,
                     ccrack, nslot, claw, cstate, chist, law1, law2, thickness, counts):
@@ -805,18 +827,10 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = -1.0
-            if side == 1 and not _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
-                total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
-                                              ref_fields, ref_tested, nodes, fields, weights, g)
-            if total < 0.0:
-                total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
-                                       cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
-                                       nodes, fields, weights, g, tested)
-                if side == 0:
-                    ref_nodes[:] = nodes
-                    ref_fields[:] = fields
-                    ref_tested[:] = tested
+            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords,
+                                cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf, g,
+                                nodes, fields, weights, tested, ref_nodes, ref_fields,
+                                ref_tested)
             if total <= 0.0:
                 continue
             for q in range(4):
@@ -855,18 +869,10 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = -1.0
-            if side == 1 and not _near_crack_end(k, cpx, cpy, ccrack, cfirst, clast, geom):
-                total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
-                                              ref_fields, ref_tested, nodes, fields, weights, g)
-            if total < 0.0:
-                total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx,
-                                       cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf,
-                                       nodes, fields, weights, g, tested)
-                if side == 0:
-                    ref_nodes[:] = nodes
-                    ref_fields[:] = fields
-                    ref_tested[:] = tested
+            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords,
+                                cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf, g,
+                                nodes, fields, weights, tested, ref_nodes, ref_fields,
+                                ref_tested)
             if total <= 0.0:
                 continue
             vx = 0.0
