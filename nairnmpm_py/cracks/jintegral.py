@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from nairnmpm_py.core.grid import Grid
+from nairnmpm_py.core.grid import GHOST, Grid
 from nairnmpm_py.core.shape import weights_1d
 from nairnmpm_py.cracks.crossing import collinear_overlap, line_crosses_crack, tri
 from nairnmpm_py.cracks.geometry import CrackSet, EXTERIOR_END
@@ -83,48 +83,83 @@ _NV = 8
 class NodalFields:
     """Mass-weighted nodal values, two fields per node (index 0 and 1 first).
 
-    Arrays are over all grid nodes (ghosts included, flat index as ``Grid``).
-    Values of a field with no mass are 0.
+    Arrays cover a window of the grid (``nodal_fields(window=...)``; by default all
+    nodes, ghosts included, when local and flat ``Grid`` indices coincide): local
+    index = (row - wj0) * wnx + (column - wi0), in ghost-inclusive node rows and
+    columns.  ``local`` maps flat grid indices to it.  Values of a field with no
+    mass are 0.
     """
     kind: int
-    mass: np.ndarray      # (2, nn) g
-    grad: np.ndarray      # (2, 4, nn) du/dx, du/dy, dv/dx, dv/dy
-    stress: np.ndarray    # (2, 3, nn) sxx, syy, sxy (MPa)
-    W: np.ndarray         # (2, nn) strain energy density (MPa = N/mm^2)
-    K: np.ndarray         # (2, nn) kinetic energy density (MPa)
-    crack: np.ndarray     # (nn,) crack index of field 1, -1 if none
-    side: np.ndarray      # (nn,) side of the crack of field 1's particles (+1 above, -1 below)
-    multi: np.ndarray     # (nn,) bool: node sees two different cracks (not supported)
+    mass: np.ndarray      # (2, nw) g
+    grad: np.ndarray      # (2, 4, nw) du/dx, du/dy, dv/dx, dv/dy
+    stress: np.ndarray    # (2, 3, nw) sxx, syy, sxy (MPa)
+    W: np.ndarray         # (2, nw) strain energy density (MPa = N/mm^2)
+    K: np.ndarray         # (2, nw) kinetic energy density (MPa)
+    crack: np.ndarray     # (nw,) crack index of field 1, -1 if none
+    side: np.ndarray      # (nw,) side of the crack of field 1's particles (+1 above, -1 below)
+    multi: np.ndarray     # (nw,) bool: node sees two different cracks (not supported)
     conflicts: int        # particle-node pairs put in field 0 because they crossed
                           # field 1's crack from the unexpected side (node on a crack)
+    nnx: int = 0          # nodes per grid row (ghosts included)
+    wi0: int = 0          # window: first column and row, columns per row
+    wj0: int = 0
+    wnx: int = 0
+
+    def local(self, node):
+        """Window index of flat grid node index(es) ``node`` (must lie in the window)."""
+        node = np.asarray(node)
+        return (node // self.nnx - self.wj0) * self.wnx + (node % self.nnx - self.wi0)
 
     def values(self, node: int, field: int) -> np.ndarray | None:
-        """The value vector at (node, field) for the contour, or None if empty."""
-        if self.mass[field, node] <= 0.0:
+        """The value vector at (flat grid node, field) for the contour, or None if
+        empty."""
+        k = int(self.local(node))
+        if self.mass[field, k] <= 0.0:
             return None
         v = np.empty(_NV)
-        v[0:4] = self.grad[field, :, node]
-        v[4:7] = self.stress[field, :, node]
-        v[_WK] = self.W[field, node] + self.K[field, node]
+        v[0:4] = self.grad[field, :, k]
+        v[4:7] = self.stress[field, :, k]
+        v[_WK] = self.W[field, k] + self.K[field, k]
         return v
 
+    def field_crack(self, node: int) -> int:
+        """Crack index of field 1 at a flat grid node (-1 none)."""
+        return int(self.crack[int(self.local(node))])
+
+    def table(self, nodes: np.ndarray, field: int) -> tuple[np.ndarray, np.ndarray]:
+        """(value vectors (len(nodes), 8) for the contour, has-mass mask) at flat grid
+        nodes ``nodes`` for one field."""
+        k = self.local(nodes)
+        v = np.empty((len(k), _NV))
+        v[:, 0:4] = self.grad[field][:, k].T
+        v[:, 4:7] = self.stress[field][:, k].T
+        v[:, _WK] = self.W[field, k] + self.K[field, k]
+        return v, self.mass[field, k] > 0.0
 
 @njit(cache=True)
 def _extrapolate(pos, vel, mass, vol0, lp, F, stress, w, geom, kind,
-                 cx, cy, cfirst, ccount, cext0, cext1, cbox,
+                 cx, cy, cfirst, ccount, cext0, cext1, cbox, wi0, wi1, wj0, wj1,
                  m, g, s, en, ke, ncrack, nside, multi, counts):
-    """Serial particle loop (the first particle to claim field 1 fixes its side)."""
+    """Serial particle loop (the first particle to claim field 1 fixes its side).
+    Only nodes in columns wi0..wi1 and rows wj0..wj1 are filled (window arrays)."""
     n = pos.shape[1]
     x0 = geom[0]
     y0 = geom[1]
     hx = geom[2]
     hy = geom[3]
-    nnx = int(geom[4])
+    wnx = wi1 - wi0 + 1
     na = 2 if kind == 0 else 3
     ncr = cfirst.shape[0]
+    # a particle reaches nodes less than 1.5 cells away (uGIMP, lp <= 0.5)
+    xlo = x0 + (wi0 - 1.5) * hx
+    xhi = x0 + (wi1 + 1.5) * hx
+    ylo = y0 + (wj0 - 1.5) * hy
+    yhi = y0 + (wj1 + 1.5) * hy
     for p in range(n):
         px = pos[0, p]
         py = pos[1, p]
+        if px < xlo or px > xhi or py < ylo or py > yhi:
+            continue
         i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d((px - x0) / hx, kind, lp[0, p])
         j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d((py - y0) / hy, kind, lp[1, p])
         mp = mass[p]
@@ -139,7 +174,9 @@ def _extrapolate(pos, vel, mass, vol0, lp, F, stress, w, geom, kind,
                 sw = sy * (sx0 if a == 0 else (sx1 if a == 1 else sx2))
                 if sw == 0.0:
                     continue
-                k = (j0 + b) * nnx + i0 + a
+                if i0 + a < wi0 or i0 + a > wi1 or j0 + b < wj0 or j0 + b > wj1:
+                    continue
+                k = (j0 + b - wj0) * wnx + i0 + a - wi0
                 ndx = x0 + (i0 + a) * hx
                 ndy = y0 + (j0 + b) * hy
                 found = -1
@@ -215,7 +252,7 @@ def _crack_arrays(cracks: CrackSet | None):
 
 
 def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
-                 lp=None, strict: bool = True) -> NodalFields:
+                 lp=None, strict: bool = True, window=None) -> NodalFields:
     """Extrapolate the J-integral quantities to the grid, per side of the cracks.
 
     kind: ``shape.LINEAR`` (0) or ``shape.UGIMP`` (1), as the engine.
@@ -224,6 +261,9 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
     strict: raise ValueError if any node sees two different cracks; with False those
     nodes are only flagged (``multi``) and ``j_integral`` refuses contours through
     them.
+    window: (i_lo, i_hi, j_lo, j_hi) real-grid node columns and rows (inclusive) to
+    fill, clipped to the grid; None = every node.  J needs only its contour's nodes,
+    so the crack scene asks for the square around the tip.
     """
     n = particles.pos.shape[1]
     if lp is None:
@@ -232,15 +272,21 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
         lpa = np.broadcast_to(np.asarray(lp, dtype=float), (2, n))
     lpa = np.ascontiguousarray(np.broadcast_to(lpa, (2, n)))
     geom = grid.geometry_vector()
-    nn = grid.n_nodes
-    m = np.zeros((2, nn))
-    g = np.zeros((2, 4, nn))
-    s = np.zeros((2, 3, nn))
-    en = np.zeros((2, nn))
-    ke = np.zeros((2, nn))
-    ncrack = np.full(nn, -1, dtype=np.int64)
-    nside = np.zeros(nn, dtype=np.int64)
-    multi = np.zeros(nn, dtype=np.bool_)
+    if window is None:
+        wi0, wi1, wj0, wj1 = 0, grid.nodes_x - 1, 0, grid.nodes_y - 1
+    else:
+        i_lo, i_hi, j_lo, j_hi = window
+        wi0, wi1 = max(int(i_lo) + GHOST, 0), min(int(i_hi) + GHOST, grid.nodes_x - 1)
+        wj0, wj1 = max(int(j_lo) + GHOST, 0), min(int(j_hi) + GHOST, grid.nodes_y - 1)
+    nw = (wi1 - wi0 + 1) * (wj1 - wj0 + 1)
+    m = np.zeros((2, nw))
+    g = np.zeros((2, 4, nw))
+    s = np.zeros((2, 3, nw))
+    en = np.zeros((2, nw))
+    ke = np.zeros((2, nw))
+    ncrack = np.full(nw, -1, dtype=np.int64)
+    nside = np.zeros(nw, dtype=np.int64)
+    multi = np.zeros(nw, dtype=np.bool_)
     counts = np.zeros(2, dtype=np.int64)
     cx, cy, first, count, ext0, ext1, box = _crack_arrays(cracks)
     _extrapolate(np.ascontiguousarray(particles.pos, dtype=float),
@@ -250,13 +296,15 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
                  np.ascontiguousarray(particles.F, dtype=float),
                  np.ascontiguousarray(particles.stress, dtype=float),
                  np.ascontiguousarray(particles.w, dtype=float),
-                 geom, int(kind), cx, cy, first, count, ext0, ext1, box,
+                 geom, int(kind), cx, cy, first, count, ext0, ext1, box, wi0, wi1, wj0, wj1,
                  m, g, s, en, ke, ncrack, nside, multi, counts)
+    wnx = wi1 - wi0 + 1
     if strict and multi.any():
         k = int(np.argmax(multi))
-        x, y = grid.node_coordinates()
+        x = geom[0] + (wi0 + k % wnx) * grid.dx
+        y = geom[1] + (wj0 + k // wnx) * grid.dy
         raise ValueError(
-            f"node at ({x[k]:g}, {y[k]:g}) mm sees two different cracks "
+            f"node at ({x:g}, {y:g}) mm sees two different cracks "
             f"({int(multi.sum())} such nodes): the J-integral fields support one crack "
             "near a node; move the cracks apart or refine the grid")
     if counts[0] > 0:
@@ -267,7 +315,8 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
         inv = np.where(m > 0.0, 1.0 / np.where(m > 0.0, m, 1.0), 0.0)
     return NodalFields(kind=int(kind), mass=m, grad=g * inv[:, None, :],
                        stress=s * inv[:, None, :], W=en * inv, K=ke * inv,
-                       crack=ncrack, side=nside, multi=multi, conflicts=int(counts[0]))
+                       crack=ncrack, side=nside, multi=multi, conflicts=int(counts[0]),
+                       nnx=grid.nodes_x, wi0=wi0, wj0=wj0, wnx=wnx)
 
 
 @dataclass
@@ -334,6 +383,15 @@ def _integrand(v: np.ndarray | None, nx: float, ny: float) -> np.ndarray:
     return np.array([fx, fy])
 
 
+def _integrands(V: np.ndarray, has: np.ndarray, nx: np.ndarray, ny: np.ndarray) -> np.ndarray:
+    """``_integrand`` for rows of value vectors (zero where ``has`` is False)."""
+    tx = V[:, _SXX] * nx + V[:, _SXY] * ny
+    ty = V[:, _SXY] * nx + V[:, _SYY] * ny
+    fx = V[:, _WK] * nx - (tx * V[:, _GXX] + ty * V[:, _GYX])
+    fy = V[:, _WK] * ny - (tx * V[:, _GXY] + ty * V[:, _GYY])
+    return np.where(has[:, None], np.column_stack([fx, fy]), 0.0)
+
+
 def _blend(a: np.ndarray | None, b: np.ndarray | None, f: float) -> np.ndarray | None:
     """(1-f) a + f b, using the available one alone if the other field is empty."""
     if a is None:
@@ -367,7 +425,7 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
     path = _contour_path(ic, jc, s)
     ij = np.array(path)
     nodes = grid.node_index(ij[:, 0], ij[:, 1])
-    if fields.multi[nodes].any():
+    if fields.multi[fields.local(nodes)].any():
         raise ValueError("the J contour passes a node that sees two cracks")
     xs = grid.xmin + ij[:, 0] * hx
     ys = grid.ymin + ij[:, 1] * hy
@@ -421,28 +479,31 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
                          f"{len(hits)} times; it must cross it exactly once")
     e_hit, f_hit, _, k_hit, u_hit = hits[0]
 
-    J = np.zeros(2)
-    any_mass = False
-    for e in range(len(path) - 1):
-        n1, n2 = int(nodes[e]), int(nodes[e + 1])
-        dxe, dye = xs[e + 1] - xs[e], ys[e + 1] - ys[e]
-        ds = math.hypot(dxe, dye)
-        nx, ny = dye / ds, -dxe / ds                 # outward for a CCW walk
-        v1 = fields.values(n1, 0)
-        v2 = fields.values(n2, 0)
-        any_mass |= v1 is not None or v2 is not None
-        if e != e_hit:
-            J += 0.5 * (_integrand(v1, nx, ny) + _integrand(v2, nx, ny)) * ds
-            continue
-        f = f_hit
-        a1 = fields.values(n1, 1) if fields.crack[n1] == crack_index else None
-        a2 = fields.values(n2, 1) if fields.crack[n2] == crack_index else None
-        end_v = _blend(v1, a2, f)        # node1's side, at the crossing
-        start_v = _blend(a1, v2, f)      # node2's side, at the crossing
-        J += 0.5 * (_integrand(v1, nx, ny) + _integrand(end_v, nx, ny)) * (f * ds)
-        J += 0.5 * (_integrand(start_v, nx, ny) + _integrand(v2, nx, ny)) * ((1.0 - f) * ds)
-    if not any_mass:
+    # trapezoid rule on field 0 along every edge but the crossed one
+    V, has = fields.table(nodes, 0)
+    if not has.any():
         raise ValueError("no node of the J contour has particles")
+    dxe, dye = np.diff(xs), np.diff(ys)
+    ds = np.hypot(dxe, dye)
+    nx, ny = dye / ds, -dxe / ds                 # outward for a CCW walk
+    f_from = _integrands(V[:-1], has[:-1], nx, ny)
+    f_to = _integrands(V[1:], has[1:], nx, ny)
+    edge = 0.5 * (f_from + f_to) * ds[:, None]
+    edge[e_hit] = 0.0
+    J = edge.sum(axis=0)
+    # the crossed edge: each side of the crossing with that side's fields
+    e = e_hit
+    n1, n2 = int(nodes[e]), int(nodes[e + 1])
+    v1 = V[e] if has[e] else None
+    v2 = V[e + 1] if has[e + 1] else None
+    f = f_hit
+    a1 = fields.values(n1, 1) if fields.field_crack(n1) == crack_index else None
+    a2 = fields.values(n2, 1) if fields.field_crack(n2) == crack_index else None
+    end_v = _blend(v1, a2, f)        # node1's side, at the crossing
+    start_v = _blend(a1, v2, f)      # node2's side, at the crossing
+    nxe, nye = nx[e], ny[e]
+    J += 0.5 * (_integrand(v1, nxe, nye) + _integrand(end_v, nxe, nye)) * (f * ds[e])
+    J += 0.5 * (_integrand(start_v, nxe, nye) + _integrand(v2, nxe, nye)) * ((1.0 - f) * ds[e])
 
     Jx, Jy = float(J[0]), float(J[1])
     J1 = Jx * d[0] + Jy * d[1]

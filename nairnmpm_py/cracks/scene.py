@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -224,8 +223,8 @@ class CrackScene:
         with warnings.catch_warnings():
             # nodes or particles on a crack line: counted, reported in run.json
             warnings.simplefilter("ignore", RuntimeWarning)
-            fields = nodal_fields(sim.grid, self._near_tips(sim, tips, max(sizes)),
-                                  self.cracks, sim.shape, strict=False)
+            fields = nodal_fields(sim.grid, sim.particles, self.cracks, sim.shape,
+                                  strict=False, window=self._contour_window(sim, tips, max(sizes)))
         self.j_conflicts += fields.conflicts
         rows = []
         for tip in tips:
@@ -233,18 +232,14 @@ class CrackScene:
                 rows.append(self._tip_row(sim, fields, tip, int(size)))
         return rows
 
-    def _near_tips(self, sim, tips, size: int):
-        """The particles that reach the nodes of contours of half-size ``size`` cells
-        around these tips (J needs nodal values on the contour only)."""
-        p = sim.particles
-        reach = (size + 3) * max(sim.grid.dx, sim.grid.dy)
-        keep = np.zeros(p.n, dtype=bool)
-        for tip in tips:
-            x, y = self._tip_point(tip)
-            keep |= (np.abs(p.pos[0] - x) <= reach) & (np.abs(p.pos[1] - y) <= reach)
-        return SimpleNamespace(**{name: np.ascontiguousarray(getattr(p, name)[..., keep])
-                                  for name in ("pos", "vel", "mass", "vol0", "lp", "F",
-                                               "stress", "w")})
+    def _contour_window(self, sim, tips, size: int) -> tuple[int, int, int, int]:
+        """Real-grid node columns and rows (inclusive) holding the contours of
+        half-size up to ``size`` cells around these tips (J needs nodal values on
+        its contour only)."""
+        g = sim.grid
+        i = [math.floor((self._tip_point(t)[0] - g.xmin) / g.dx + 0.5) for t in tips]
+        j = [math.floor((self._tip_point(t)[1] - g.ymin) / g.dy + 0.5) for t in tips]
+        return min(i) - size, max(i) + size, min(j) - size, max(j) + size
 
     def _tip_row(self, sim, fields, tip: Tip, size: int) -> dict:
         cs = self.cracks
