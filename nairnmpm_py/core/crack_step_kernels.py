@@ -38,7 +38,7 @@ from numba import njit, prange
 from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, _stress_update, _store_weights  # KERNEL-BASE
 from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
 from nairnmpm_py.cracks.crossing import segment_crossing_side
-from nairnmpm_py.cracks.fields import _chord, cell_segments
+from nairnmpm_py.cracks.fields import _chord, _chord_cells
 
 STATUS_CRACK_LEFT_GRID = 4
 
@@ -71,7 +71,7 @@ def _pair_field(x, y, xn, yn, node, cell, cstart, chords, cpx, cpy, cfirst, clas
     s0 = 0
     s1 = 0
     bad = 0
-    for q in range(cstart[cell], cstart[cell + 1]):
+    for q in range(cstart[0, cell], cstart[1, cell]):
         k = chords[q]
         x3, y3, x4, y4 = _chord(k, cpx, cpy, cfirst, clast, cext0, cext1, ccrack)
         hit = segment_crossing_side(x, y, xn, yn, x3, y3, x4, y4)
@@ -96,35 +96,6 @@ def _cell_of(x, y, geom, ncx, ncy):
     ci = min(max(int(math.floor((x - geom[0]) / geom[2])), 0), ncx - 1)
     cj = min(max(int(math.floor((y - geom[1]) / geom[3])), 0), ncy - 1)
     return cj * ncx + ci
-
-
-@njit(cache=True)
-def node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot):
-    """The two lowest-numbered cracks with a chord listed in a cell next to each node."""
-    nn = nslot.shape[1]
-    for k in range(nn):
-        i = k % nnx
-        j = k // nnx
-        a = -1
-        b = -1
-        for cj in range(j - 1, j + 1):
-            if cj < 0 or cj >= ncy:
-                continue
-            for ci in range(i - 1, i + 1):
-                if ci < 0 or ci >= ncx:
-                    continue
-                cell = cj * ncx + ci
-                for q in range(cstart[cell], cstart[cell + 1]):
-                    c = ccrack[chords[q]]
-                    if c == a or c == b:
-                        continue
-                    if a < 0 or c < a:
-                        b = a
-                        a = c
-                    elif b < 0 or c < b:
-                        b = c
-        nslot[0, k] = a
-        nslot[1, k] = b
 
 
 # ---- particles -> grid ----------------------------------------------------------------
@@ -170,7 +141,7 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, cut, nn
     else:
         mux = m * (x - pos0[0, p])
         muy = m * (y - pos0[1, p])
-    has_chords = cstart[cell + 1] > cstart[cell]
+    has_chords = cstart[1, cell] > cstart[0, cell]
     any_cut = 0
     for b in range(NA):
         sy = r[3 + b]
@@ -529,25 +500,39 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
                 L01 = 0.0
                 L10 = 0.0
                 L11 = 0.0
-                for b in range(NA):
-                    sy = r[3 + b]
-                    dy = r[9 + b]
-                    row = (j0 + b) * nnx + i0
-                    for a in range(NA):
-                        k = row + a
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
-                        if cp_:
+                # the branch on ``cut`` is taken once per particle, not per node, so
+                # the uncut particles run the same loop as the no-crack step
+                if cp_:
+                    for b in range(NA):
+                        sy = r[3 + b]
+                        dy = r[9 + b]
+                        row = (j0 + b) * nnx + i0
+                        for a in range(NA):
+                            k = row + a
+                            gx = r[6 + a] * sy
+                            gy = r[a] * dy
                             f = vfld[p, b * NA + a]
                             vx = gv[f, 0, k]
                             vy = gv[f, 1, k]
-                        else:
+                            L00 += vx * gx
+                            L01 += vx * gy
+                            L10 += vy * gx
+                            L11 += vy * gy
+                else:
+                    for b in range(NA):
+                        sy = r[3 + b]
+                        dy = r[9 + b]
+                        row = (j0 + b) * nnx + i0
+                        for a in range(NA):
+                            k = row + a
+                            gx = r[6 + a] * sy
+                            gy = r[a] * dy
                             vx = gv0[0, k]
                             vy = gv0[1, k]
-                        L00 += vx * gx
-                        L01 += vx * gy
-                        L10 += vy * gx
-                        L11 += vy * gy
+                            L00 += vx * gx
+                            L01 += vx * gy
+                            L10 += vy * gx
+                            L11 += vy * gy
                 if dt_pre > 0.0:
                     _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
                                    mat_params, plane_stress)
@@ -560,19 +545,27 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
             sxx = stress[0, p] * vol
             syy = stress[1, p] * vol
             sxy = stress[2, p] * vol
-            for b in range(NA):
-                sy = r[3 + b]
-                dy = r[9 + b]
-                row = (j0 + b) * nnx + i0
-                for a in range(NA):
-                    k = row + a
-                    gx = r[6 + a] * sy
-                    gy = r[a] * dy
-                    if cp_:
+            if cp_:
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
                         fb = buf[vfld[p, b * NA + a]]
                         fb[GFX, k] -= sxx * gx + sxy * gy
                         fb[GFY, k] -= sxy * gx + syy * gy
-                    else:
+            else:
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
                         b0[GFX, k] -= sxx * gx + sxy * gy
                         b0[GFY, k] -= sxy * gx + syy * gy
 
@@ -1029,21 +1022,122 @@ def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
 
 
 @njit(cache=True)
-def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, nslot):
+def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, nslot, cstart,
+                cnear, cbox):
     """Chords near each cell, the crack slots of every node and the nodes that have
-    one (the only nodes where fields can differ), for the current plane."""
-    cstart, chords = cell_segments(cp[0], cp[1], cfirst, clast, cext0, cext1, ccrack, geom,
-                                   ncx, ncy)
-    node_slots(cstart, chords, ccrack, ncx, ncy, nnx, nslot)
-    cnear = np.zeros(ncx * ncy, dtype=np.uint8)
-    for j in range(ncy):
-        for i in range(ncx):
+    one (the only nodes where fields can differ), for the current plane.
+
+    Work and writes stay inside the box of cells the chords reach (``cbox``: i0, i1,
+    j0, j1, kept between calls so the previous box is cleared first), so the cost
+    follows the crack, not the grid.  ``cstart[0, cell]`` to ``cstart[1, cell]`` index
+    the cell's chords in the returned ``chords``; every other cell has an empty range.
+    ``cnear`` marks cells within NEAR_CELLS of a cell with chords; ``nslot`` holds a
+    node's two lowest-numbered cracks listed in a cell next to it (-1 none).
+    """
+    px = cp[0]
+    py = cp[1]
+    nn = nslot.shape[1]
+    nny = nn // nnx
+    # clear the previous box (cells with their near margin, nodes of those cells)
+    if cbox[0] <= cbox[1]:
+        for j in range(max(cbox[2] - NEAR_CELLS, 0), min(cbox[3] + NEAR_CELLS + 1, ncy)):
+            for i in range(max(cbox[0] - NEAR_CELLS, 0), min(cbox[1] + NEAR_CELLS + 1, ncx)):
+                cell = j * ncx + i
+                cstart[0, cell] = 0
+                cstart[1, cell] = 0
+                cnear[cell] = 0
+        for j in range(cbox[2], min(cbox[3] + 2, nny)):
+            for i in range(cbox[0], min(cbox[1] + 2, nnx)):
+                nslot[0, j * nnx + i] = -1
+                nslot[1, j * nnx + i] = -1
+    # the new box
+    n = px.size
+    i_lo = ncx
+    i_hi = -1
+    j_lo = ncy
+    j_hi = -1
+    for k in range(n - 1):
+        if ccrack[k] != ccrack[k + 1]:
+            continue
+        i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
+                                      ncx, ncy)
+        i_lo = min(i_lo, i0)
+        i_hi = max(i_hi, i1)
+        j_lo = min(j_lo, j0)
+        j_hi = max(j_hi, j1)
+    cbox[0] = i_lo
+    cbox[1] = i_hi
+    cbox[2] = j_lo
+    cbox[3] = j_hi
+    if i_lo > i_hi:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    bw = i_hi - i_lo + 1
+    count = np.zeros(bw * (j_hi - j_lo + 1) + 1, dtype=np.int64)
+    for k in range(n - 1):
+        if ccrack[k] != ccrack[k + 1]:
+            continue
+        i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
+                                      ncx, ncy)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                count[(j - j_lo) * bw + i - i_lo + 1] += 1
+    for q in range(count.size - 1):
+        count[q + 1] += count[q]
+    chords = np.empty(count[count.size - 1], dtype=np.int64)
+    for j in range(j_lo, j_hi + 1):
+        for i in range(i_lo, i_hi + 1):
+            b = (j - j_lo) * bw + i - i_lo
             cell = j * ncx + i
-            if cstart[cell + 1] > cstart[cell]:
-                for jj in range(max(j - NEAR_CELLS, 0), min(j + NEAR_CELLS + 1, ncy)):
-                    for ii in range(max(i - NEAR_CELLS, 0), min(i + NEAR_CELLS + 1, ncx)):
-                        cnear[jj * ncx + ii] = 1
-    return cstart, chords, np.flatnonzero(nslot[0] >= 0), cnear
+            cstart[0, cell] = count[b]
+            cstart[1, cell] = count[b]
+    for k in range(n - 1):
+        if ccrack[k] != ccrack[k + 1]:
+            continue
+        i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
+                                      ncx, ncy)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                cell = j * ncx + i
+                chords[cstart[1, cell]] = k
+                cstart[1, cell] += 1
+    # near cells and node slots
+    nc = 0
+    for j in range(j_lo, j_hi + 1):
+        for i in range(i_lo, i_hi + 1):
+            cell = j * ncx + i
+            if cstart[1, cell] == cstart[0, cell]:
+                continue
+            for jj in range(max(j - NEAR_CELLS, 0), min(j + NEAR_CELLS + 1, ncy)):
+                for ii in range(max(i - NEAR_CELLS, 0), min(i + NEAR_CELLS + 1, ncx)):
+                    cnear[jj * ncx + ii] = 1
+    cnodes = np.empty((bw + 1) * (j_hi - j_lo + 2), dtype=np.int64)
+    for j in range(j_lo, min(j_hi + 2, nny)):
+        for i in range(i_lo, min(i_hi + 2, nnx)):
+            node = j * nnx + i
+            a = -1
+            b = -1
+            for cj in range(j - 1, j + 1):
+                if cj < 0 or cj >= ncy:
+                    continue
+                for ci in range(i - 1, i + 1):
+                    if ci < 0 or ci >= ncx:
+                        continue
+                    cell = cj * ncx + ci
+                    for q in range(cstart[0, cell], cstart[1, cell]):
+                        c = ccrack[chords[q]]
+                        if c == a or c == b:
+                            continue
+                        if a < 0 or c < a:
+                            b = a
+                            a = c
+                        elif b < 0 or c < b:
+                            b = c
+            nslot[0, node] = a
+            nslot[1, node] = b
+            if a >= 0:
+                cnodes[nc] = node
+                nc += 1
+    return chords, cnodes[:nc]
 
 
 @njit(cache=True, error_model="numpy")
@@ -1054,8 +1148,8 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
-            law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, counts,
-            chunk_counts, resume, flush, pend):
+            law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cstart,
+            cnear, cbox, counts, chunk_counts, resume, flush, pend):
     """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
 
     Order per step: loads and internal forces into each particle's fields; crack
@@ -1087,8 +1181,8 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     dt_update = 0.0 if post_extrapolate else dt_last
     cpx = cp[0]
     cpy = cp[1]
-    cstart, chords, cnodes, cnear = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom,
-                                                ncx, ncy, nnx, nslot)
+    chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
+                                 nslot, cstart, cnear, cbox)
     pending = pend[0]
     pend[0] = 0.0
     if resume:
@@ -1101,7 +1195,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           rec_ftime, rec_force, rec_work, sym_out, sym_in, sym_dir, bad, nch,
                           cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate,
                           chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut,
-                          wij, wc, nslot, counts, chunk_counts, cstart, chords, cnodes, cnear,
+                          wij, wc, nslot, cbox, counts, chunk_counts, cstart, chords, cnodes, cnear,
                           ncx, ncy, nnx, n)
     weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
                      cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
@@ -1119,7 +1213,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                       pbc_scale, pbc_rec, rec_style, rec_value, rec_t0, rec_ftime, rec_force,
                       rec_work, sym_out, sym_in, sym_dir, bad, nch, cp, ca, cb, cfirst, clast,
                       cext0, cext1, ccrack, cfixed, claw, cstate, chist, law1, law2, thickness,
-                      use_position, cutoff_cells, vfld, cut, wij, wc, nslot, counts,
+                      use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cbox, counts,
                       chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx, n)
 
 
@@ -1131,7 +1225,8 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work, sym_out, sym_in,
                sym_dir, bad, nch, cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw,
                cstate, chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij,
-               wc, nslot, counts, chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx, n):
+               wc, nslot, cbox, counts, chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx,
+               n):
     """The steps themselves, from a current extrapolation.  Without ``flush`` the last
     step's carried USAVG+ stress half is returned in ``pend`` instead of applied."""
     pload = np.zeros(pbc_part.size)
@@ -1163,8 +1258,8 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
         if out >= 0:
             return step + 1, STATUS_CRACK_LEFT_GRID, out
         old_cnodes = cnodes
-        cstart, chords, cnodes, cnear = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack,
-                                                    geom, ncx, ncy, nnx, nslot)
+        chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
+                                     nnx, nslot, cstart, cnear, cbox)
         update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                                plane_stress, geom, ga, gvn, dt, dt_update, damping, pdamp,
                                bounds, vmax, left, bad, wij, wc, vfld, cut, gbuf, nch, ncx,

@@ -99,6 +99,10 @@ class CrackScene:
         self.wij = np.zeros((n, 2), dtype=np.int64)
         self.wc = np.zeros((n, 12))
         self.nslot = np.full((2, nn), -1, dtype=np.int64)
+        ncells = (sim.grid.nodes_x - 1) * (sim.grid.nodes_y - 1)
+        self.cstart = np.zeros((2, ncells), dtype=np.int64)   # chords of a cell (kernel)
+        self.cnear = np.zeros(ncells, dtype=np.uint8)
+        self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)    # cells the lists cover
         self.chunk_counts = np.zeros(sim.nch, dtype=np.int64)
         self._kernel_arrays()
         self.grid_current = False      # the next call must extrapolate
@@ -141,7 +145,7 @@ class CrackScene:
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
             self.law1, self.law2, float(sim.grid.thickness), use_position,
             float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
-            self.counts, self.chunk_counts, resume, flush, self.pend)
+            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush, self.pend)
 
     # ---- zone and traction work -------------------------------------------------------
     def _tip_point(self, tip: Tip) -> np.ndarray:
