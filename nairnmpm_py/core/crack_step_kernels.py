@@ -1149,14 +1149,15 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
             law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cstart,
-            cnear, cbox, counts, chunk_counts, resume, flush, pend):
+            cnear, cbox, counts, chunk_counts, resume, flush, pend, chords_now, cnodes_now):
     """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
 
     Order per step: loads and internal forces into each particle's fields; crack
     tractions; contact after the update; velocity conditions; cracks moved; particles
     updated and extrapolated to the next step's fields (crossing the moved cracks);
     contact on the new momenta; velocity conditions.  Returns (steps done, status,
-    offending particle or crack particle).
+    offending particle or crack particle, chords, crack nodes): the last two are the
+    crack lists of the last extrapolation, passed back in for a resumed call.
 
     ``resume``: the previous call's last extrapolation is still current (no crack grew,
     nothing changed), so it is not redone.  ``flush``: apply the carried USAVG+ / USL+
@@ -1181,12 +1182,11 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
     dt_update = 0.0 if post_extrapolate else dt_last
     cpx = cp[0]
     cpy = cp[1]
-    chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
-                                 nslot, cstart, cnear, cbox)
     pending = pend[0]
     pend[0] = 0.0
     if resume:
-        # the previous call ended with this state's extrapolation (nothing changed since)
+        # the previous call ended with this state's extrapolation and crack lists
+        # (``chords_now``, ``cnodes_now``; nothing changed since)
         return _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush,
                           pend, plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress,
                           hist, w, pdamp, mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp,
@@ -1195,8 +1195,10 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           rec_ftime, rec_force, rec_work, sym_out, sym_in, sym_dir, bad, nch,
                           cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate,
                           chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut,
-                          wij, wc, nslot, cbox, counts, chunk_counts, cstart, chords, cnodes, cnear,
-                          ncx, ncy, nnx, n)
+                          wij, wc, nslot, cbox, counts, chunk_counts, cstart, chords_now, cnodes_now,
+                          cnear, ncx, ncy, nnx, n)
+    chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
+                                 nslot, cstart, cnear, cbox)
     weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
                      cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
                      g.shape[0], use_position, chunk_counts)
@@ -1256,7 +1258,7 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
         out = move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast,
                           cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
         if out >= 0:
-            return step + 1, STATUS_CRACK_LEFT_GRID, out
+            return step + 1, STATUS_CRACK_LEFT_GRID, out, chords, cnodes
         old_cnodes = cnodes
         chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
                                      nnx, nslot, cstart, cnear, cbox)
@@ -1301,5 +1303,5 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                 stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
                              geom, wij, wc, vfld, cut, gv, gbuf, nch, 0.0, pending, False, n)
             if status != STATUS_OK:
-                return step + 1, status, who
-    return nsteps, STATUS_OK, -1
+                return step + 1, status, who, chords, cnodes
+    return nsteps, STATUS_OK, -1, chords, cnodes

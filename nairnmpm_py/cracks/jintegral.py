@@ -138,11 +138,12 @@ class NodalFields:
 
 @njit(cache=True)
 def _extrapolate(pos, vel, mass, vol0, lp, F, stress, w, geom, kind,
-                 cx, cy, cfirst, ccount, cext0, cext1, cbox, wi0, wi1, wj0, wj1,
+                 cx, cy, cfirst, ccount, cext0, cext1, cbox, wi0, wi1, wj0, wj1, subset,
                  m, g, s, en, ke, ncrack, nside, multi, counts):
     """Serial particle loop (the first particle to claim field 1 fixes its side).
-    Only nodes in columns wi0..wi1 and rows wj0..wj1 are filled (window arrays)."""
-    n = pos.shape[1]
+    Only nodes in columns wi0..wi1 and rows wj0..wj1 are filled (window arrays); only
+    the particles ``subset`` (ascending indices) are visited, all if it is empty."""
+    n = subset.size if subset.size > 0 else pos.shape[1]
     x0 = geom[0]
     y0 = geom[1]
     hx = geom[2]
@@ -155,7 +156,8 @@ def _extrapolate(pos, vel, mass, vol0, lp, F, stress, w, geom, kind,
     xhi = x0 + (wi1 + 1.5) * hx
     ylo = y0 + (wj0 - 1.5) * hy
     yhi = y0 + (wj1 + 1.5) * hy
-    for p in range(n):
+    for q in range(n):
+        p = subset[q] if subset.size > 0 else q
         px = pos[0, p]
         py = pos[1, p]
         if px < xlo or px > xhi or py < ylo or py > yhi:
@@ -252,7 +254,7 @@ def _crack_arrays(cracks: CrackSet | None):
 
 
 def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
-                 lp=None, strict: bool = True, window=None) -> NodalFields:
+                 lp=None, strict: bool = True, window=None, subset=None) -> NodalFields:
     """Extrapolate the J-integral quantities to the grid, per side of the cracks.
 
     kind: ``shape.LINEAR`` (0) or ``shape.UGIMP`` (1), as the engine.
@@ -264,6 +266,8 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
     window: (i_lo, i_hi, j_lo, j_hi) real-grid node columns and rows (inclusive) to
     fill, clipped to the grid; None = every node.  J needs only its contour's nodes,
     so the crack scene asks for the square around the tip.
+    subset: ascending indices of the only particles that may reach the window (a
+    cache kept by the caller); None = test every particle.
     """
     n = particles.pos.shape[1]
     if lp is None:
@@ -297,6 +301,7 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
                  np.ascontiguousarray(particles.stress, dtype=float),
                  np.ascontiguousarray(particles.w, dtype=float),
                  geom, int(kind), cx, cy, first, count, ext0, ext1, box, wi0, wi1, wj0, wj1,
+                 np.zeros(0, dtype=np.int64) if subset is None else subset,
                  m, g, s, en, ke, ncrack, nside, multi, counts)
     wnx = wi1 - wi0 + 1
     if strict and multi.any():
@@ -401,6 +406,65 @@ def _blend(a: np.ndarray | None, b: np.ndarray | None, f: float) -> np.ndarray |
     return (1.0 - f) * a + f * b
 
 
+_MAX_HITS = 16
+
+
+@njit(cache=True)
+def _contour_hits(xs, ys, px, py, first, count, tol, found):
+    """Crossings of the contour's edges (path xs, ys) with every crack's chords, in
+    walk order, into ``found`` rows (edge, t along the edge, crack, chord start
+    particle, u along the chord).  Returns (number of crossings, edge where a chord
+    runs along it or -1, that chord's crack).
+
+    Sign tests as in the particle-node crossing test: a crack particle exactly on an
+    edge's line is counted by one of its two chords only (its side value is the same
+    float for both, and 0 counts as positive), and a node exactly on a chord's line
+    by one edge only ((0, 1] along the walk), so nothing is counted twice or lost to
+    rounding.
+    """
+    lo_x = xs.min()
+    hi_x = xs.max()
+    lo_y = ys.min()
+    hi_y = ys.max()
+    nhit = 0
+    for e in range(xs.size - 1):
+        ax = xs[e]
+        ay = ys[e]
+        bx = xs[e + 1]
+        by = ys[e + 1]
+        for c in range(first.size):
+            for k in range(first[c], first[c] + count[c] - 1):
+                cx0 = px[k]
+                cy0 = py[k]
+                cx1 = px[k + 1]
+                cy1 = py[k + 1]
+                # a chord with both ends strictly inside the square cannot cross it
+                if (min(cx0, cx1) > lo_x and max(cx0, cx1) < hi_x
+                        and min(cy0, cy1) > lo_y and max(cy0, cy1) < hi_y):
+                    continue
+                if (max(cx0, cx1) < min(ax, bx) or min(cx0, cx1) > max(ax, bx)
+                        or max(cy0, cy1) < min(ay, by) or min(cy0, cy1) > max(ay, by)):
+                    continue
+                if collinear_overlap(ax, ay, bx, by, cx0, cy0, cx1, cy1, tol):
+                    return nhit, e, c
+                a1 = tri(ax, ay, bx, by, cx0, cy0)
+                a2 = tri(ax, ay, bx, by, cx1, cy1)
+                if (a1 < 0.0) == (a2 < 0.0):
+                    continue                    # chord does not straddle the edge line
+                b1 = tri(cx0, cy0, cx1, cy1, ax, ay)
+                b2 = tri(cx0, cy0, cx1, cy1, bx, by)
+                if not ((b1 < 0.0 and b2 >= 0.0) or (b1 > 0.0 and b2 <= 0.0)):
+                    continue                    # edge does not straddle the chord line
+                if nhit < found.shape[0]:
+                    found[nhit, 0] = e
+                    found[nhit, 1] = b1 / (b1 - b2)
+                    found[nhit, 2] = c
+                    found[nhit, 3] = k
+                    found[nhit, 4] = a1 / (a1 - a2)
+                nhit += 1
+    return nhit, -1, -1
+
+
 def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: int,
                tip_end: str = "end", size_cells: int = 2) -> JResult:
     """J integral of one crack tip on a square grid contour (JINTEGRAL.md sections 2-4).
@@ -437,39 +501,19 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
     # one edge only ((0, 1] along the walk), so nothing is counted twice or lost to
     # rounding.
     P = cracks.plane
-    # only chords whose bounding box meets the contour's can cross it
-    lo_x, hi_x, lo_y, hi_y = xs.min(), xs.max(), ys.min(), ys.max()
-    near = []
-    for c in range(cracks.n_cracks):
-        k0, kn = int(cracks.first[c]), int(cracks.count[c])
-        a, b = P[:, k0:k0 + kn - 1], P[:, k0 + 1:k0 + kn]
-        meet = ((np.maximum(a[0], b[0]) >= lo_x) & (np.minimum(a[0], b[0]) <= hi_x)
-                & (np.maximum(a[1], b[1]) >= lo_y) & (np.minimum(a[1], b[1]) <= hi_y))
-        # a chord with both ends strictly inside the square cannot cross its edges
-        inside = ((np.minimum(a[0], b[0]) > lo_x) & (np.maximum(a[0], b[0]) < hi_x)
-                  & (np.minimum(a[1], b[1]) > lo_y) & (np.maximum(a[1], b[1]) < hi_y))
-        meet &= ~inside
-        near += [(c, k0 + int(i)) for i in np.flatnonzero(meet)]
-    hits = []   # (edge, t along edge, crack, chord start particle k, u along chord)
-    for e in range(len(path) - 1):
-        ax, ay, bx, by = xs[e], ys[e], xs[e + 1], ys[e + 1]
-        for c, k in near:
-            cx0, cy0, cx1, cy1 = P[0, k], P[1, k], P[0, k + 1], P[1, k + 1]
-            if (max(cx0, cx1) < min(ax, bx) or min(cx0, cx1) > max(ax, bx)
-                    or max(cy0, cy1) < min(ay, by) or min(cy0, cy1) > max(ay, by)):
-                continue
-            if collinear_overlap(ax, ay, bx, by, cx0, cy0, cx1, cy1, 1e-12 * (hx + hy)):
-                raise ValueError(f"crack {c} runs along a J-contour edge near "
-                                 f"({ax:g}, {ay:g}); keep cracks off grid lines")
-            a1 = tri(ax, ay, bx, by, cx0, cy0)
-            a2 = tri(ax, ay, bx, by, cx1, cy1)
-            if (a1 < 0.0) == (a2 < 0.0):
-                continue                    # chord does not straddle the edge line
-            b1 = tri(cx0, cy0, cx1, cy1, ax, ay)
-            b2 = tri(cx0, cy0, cx1, cy1, bx, by)
-            if not ((b1 < 0.0 and b2 >= 0.0) or (b1 > 0.0 and b2 <= 0.0)):
-                continue                    # edge does not straddle the chord line
-            hits.append((e, b1 / (b1 - b2), c, k, a1 / (a1 - a2)))
+    first = np.ascontiguousarray(cracks.first, dtype=np.int64)
+    count = np.ascontiguousarray(cracks.count, dtype=np.int64)
+    found = np.zeros((_MAX_HITS, 5))
+    nhit, bad_edge, bad_crack = _contour_hits(xs, ys, P[0], P[1], first, count,
+                                              1e-12 * (hx + hy), found)
+    if bad_edge >= 0:
+        raise ValueError(f"crack {bad_crack} runs along a J-contour edge near "
+                         f"({xs[bad_edge]:g}, {ys[bad_edge]:g}); keep cracks off grid lines")
+    # (edge, t along edge, crack, chord start particle k, u along chord)
+    hits = [(int(h[0]), float(h[1]), int(h[2]), int(h[3]), float(h[4]))
+            for h in found[:min(nhit, _MAX_HITS)]]
+    if nhit > _MAX_HITS:
+        hits += [(-1, 0.0, crack_index, -1, 0.0)] * (nhit - _MAX_HITS)   # only counted
     others = [h for h in hits if h[2] != crack_index]
     if others:
         raise ValueError(f"crack {others[0][2]} crosses the J contour of crack "

@@ -28,6 +28,7 @@ from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_i
 
 INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
 NO_MODE = -1.0
+WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J window
 
 
 @dataclass
@@ -107,6 +108,8 @@ class CrackScene:
         self._kernel_arrays()
         self.grid_current = False      # the next call must extrapolate
         self.pend = np.zeros(1)        # USAVG+ stress half carried between calls
+        self.chords_now = np.zeros(0, dtype=np.int64)   # crack lists of the last call
+        self.cnodes_now = np.zeros(0, dtype=np.int64)
         if self.growing:
             # NairnMPM checks for growth every CFL * cell / wave speed (at least a step)
             prop_time = 0.5 * min(sim.grid.dx, sim.grid.dy) / sim.max_wave_speed()
@@ -133,7 +136,7 @@ class CrackScene:
         c = sim.cond_arrays
         cs = self.cracks
         use_position = self.contact_position is not None
-        return self.kernels.advance(
+        done, status, who, self.chords_now, self.cnodes_now = self.kernels.advance(
             nsteps, sim.time, sim.dt, sim.method, sim.post_extrapolate, sim.plane_stress,
             p.pos, p.pos0, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress, p.hist, p.w,
             p.pdamp, sim.mat_params, sim.geom, sim.bounds, self.g, self.gbuf, self.gv,
@@ -145,7 +148,9 @@ class CrackScene:
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
             self.law1, self.law2, float(sim.grid.thickness), use_position,
             float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
-            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush, self.pend)
+            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush, self.pend,
+            self.chords_now, self.cnodes_now)
+        return done, status, who
 
     # ---- zone and traction work -------------------------------------------------------
     def _tip_point(self, tip: Tip) -> np.ndarray:
@@ -227,8 +232,10 @@ class CrackScene:
         with warnings.catch_warnings():
             # nodes or particles on a crack line: counted, reported in run.json
             warnings.simplefilter("ignore", RuntimeWarning)
+            window = self._contour_window(sim, tips, max(sizes))
             fields = nodal_fields(sim.grid, sim.particles, self.cracks, sim.shape,
-                                  strict=False, window=self._contour_window(sim, tips, max(sizes)))
+                                  strict=False, window=window,
+                                  subset=self._window_particles(sim, window))
         self.j_conflicts += fields.conflicts
         rows = []
         for tip in tips:
@@ -244,6 +251,24 @@ class CrackScene:
         i = [math.floor((self._tip_point(t)[0] - g.xmin) / g.dx + 0.5) for t in tips]
         j = [math.floor((self._tip_point(t)[1] - g.ymin) / g.dy + 0.5) for t in tips]
         return min(i) - size, max(i) + size, min(j) - size, max(j) + size
+
+    def _window_particles(self, sim, window) -> np.ndarray:
+        """Particles that may reach the nodes of ``window``: found again when the window
+        changes or every ``WINDOW_REFRESH`` checks, with a margin of a cell more than
+        a particle can reach, which no particle crosses in that many steps (a CFL
+        step moves a particle well under a tenth of a cell)."""
+        self._subset_age = getattr(self, "_subset_age", 0) + 1
+        if getattr(self, "_subset_window", None) != window or self._subset_age > WINDOW_REFRESH:
+            g, p = sim.grid, sim.particles
+            i0, i1, j0, j1 = window
+            reach = 2.5      # cells: uGIMP reach (1.5) plus a cell of margin
+            x, y = p.pos
+            keep = ((x >= g.xmin + (i0 - reach) * g.dx) & (x <= g.xmin + (i1 + reach) * g.dx)
+                    & (y >= g.ymin + (j0 - reach) * g.dy) & (y <= g.ymin + (j1 + reach) * g.dy))
+            self._subset = np.flatnonzero(keep).astype(np.int64)
+            self._subset_window = window
+            self._subset_age = 0
+        return self._subset
 
     def _tip_row(self, sim, fields, tip: Tip, size: int) -> dict:
         cs = self.cracks
