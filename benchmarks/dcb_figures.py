@@ -8,14 +8,18 @@ entities from the sweep's ``summary.csv`` (J_tip,c, J_B, sigma_c, Tprop), and dr
 
 * Fig 7: R against the opening at the notch root, Eq 22 dashed (bridging and
   cohesive members);
-* Fig 8A/9A: moment against the load-line opening of the arms;
-* Fig 8B/9B: R against crack growth;
+* Fig 8A/9A: moment against the load-line opening of the arms (8: bridging members,
+  9: cohesive members, J_tip,c < 10 J/m^2; both with the fracture-mechanics members
+  dotted, as the paper's);
+* Fig 8B/9B: R against crack growth, the same members;
 * Fig 10: bridging-zone length against the moment;
 
 into ``OUT/dcb_fig7.png`` ... ``dcb_fig10.png`` and a CSV of the checks of issue 4:
 R on the plateau against J_tip,c + J_B, the RMS of R - Eq 22 over delta/delta_c in
 0.1-0.95 in percent of J_tip,c, the median J_tip at growth, and the steady zone length.
-The moment is the template's: M = 6.7082 t N mm (t in ms).
+The moment on each arm is read from the applied loads in ``global.csv``: the force
+of the upper arm's outer row (|F|, its two components) times the distance between
+the two loaded rows of that arm (template entities ``ytop`` - ``qcs``).
 """
 from __future__ import annotations
 
@@ -24,8 +28,6 @@ import csv
 from pathlib import Path
 
 import numpy as np
-
-MOMENT_RATE = 6.7082   # N mm per ms
 
 
 def members(folder: Path) -> list[dict]:
@@ -58,6 +60,18 @@ def load_line_opening(d: Path) -> tuple[np.ndarray, np.ndarray]:
     return g["time_ms"], opening
 
 
+def moment(d: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(time ms, moment N mm on the upper arm) from the applied loads."""
+    from nairnmpm_py.analysis.results import read_csv_columns
+    from nairnmpm_py.sweep import INPUT_NAME, declared_entities
+    ent = declared_entities((d / INPUT_NAME).read_text())
+    lever = float(ent["ytop"][1]) - float(ent["qcs"][1])
+    cols, g = read_csv_columns(d / "global.csv")
+    loads = [c for c in cols if c.startswith("load_N_")]
+    # the first two load records are the upper arm's outer row (x and y components)
+    return g["time_ms"], np.hypot(g[loads[0]], g[loads[1]]) * lever
+
+
 def main() -> None:
     from nairnmpm_py.analysis.rcurve import R_cubic
     import matplotlib
@@ -70,7 +84,7 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     ms = members(Path(args.sweep))
-    figs = {k: plt.subplots(figsize=(6.4, 4.6)) for k in ("7", "8A", "8B", "10")}
+    figs = {k: plt.subplots(figsize=(6.4, 4.6)) for k in ("7", "8A", "8B", "9A", "9B", "10")}
     checks = []
     for m in ms:
         jc, jb, sc = float(m["Jtipc"]), float(m["JB"]), float(m["sigc"])
@@ -84,14 +98,20 @@ def main() -> None:
         R = g["R_J_m2"]
         d0 = g["cod_notch0_mm"]
         t, opening = load_line_opening(m["folder"])
-        figs["8A"][1].plot(opening, MOMENT_RATE * t, label=label)
-        figs["8B"][1].plot(g["crack_growth_mm"], R, ".-", label=label)
+        tm, mom = moment(m["folder"])
+        if not bridged:      # fracture mechanics: dotted in both figures
+            panels, style = ("8", "9"), ":"
+        else:
+            panels, style = ("9",) if jc < 10.0 else ("8",), "-"
+        for fig_no in panels:
+            figs[fig_no + "A"][1].plot(opening, np.interp(t, tm, mom), style, label=label)
+            figs[fig_no + "B"][1].plot(g["crack_growth_mm"], R, "." + style, label=label)
         if bridged:
             ax = figs["7"][1]
             line, = ax.plot(d0 / dc, R / (jc + jb), ".", label=label)
             x = np.linspace(0, 1.5, 200)
             ax.plot(x, R_cubic(x * dc, jc, jb, dc) / (jc + jb), "--", color=line.get_color(), lw=1)
-            figs["10"][1].plot(MOMENT_RATE * g["time_ms"], g["zone_length_mm"], ".-", label=label)
+            figs["10"][1].plot(np.interp(g["time_ms"], tm, mom), g["zone_length_mm"], ".-", label=label)
         total = jc + (jb if bridged else 0.0)
         plateau = (d0 > 1.2 * dc) if bridged else np.ones(len(R), dtype=bool)
         rising = bridged & (d0 > 0.1 * dc) & (d0 < 0.95 * dc)
@@ -111,6 +131,8 @@ def main() -> None:
     labels = {"7": ("COD at the notch root / delta_c", "R / (J_tip,c + J_B)"),
               "8A": ("load-line opening (mm)", "moment M (N mm)"),
               "8B": ("crack growth (mm)", "R (J/m^2)"),
+              "9A": ("load-line opening (mm)", "moment M (N mm)"),
+              "9B": ("crack growth (mm)", "R (J/m^2)"),
               "10": ("moment M (N mm)", "bridging zone length (mm)")}
     figs["7"][1].set_xlim(0, 3)
     for key, (fig, ax) in figs.items():
