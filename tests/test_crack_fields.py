@@ -1,61 +1,94 @@
-"""Grid-side crack kernels: chord lists per cell, particle-node fields, contact."""
+"""Grid-side crack kernels of the engine (``core/crack_step_kernels``, loaded here as
+the plain template): chord lists per cell, the particle-node field choice, contact."""
 import numpy as np
 
-from nairnmpm_py.cracks import fields
+from nairnmpm_py.core import crack_step_kernels as K
 
 GEOM = np.array([-1.0, -1.0, 1.0, 1.0, 12.0])   # node 0 at (-1, -1), 1 mm cells
+NNX = 12
 NCX = NCY = 11
+
+
+class Lists:
+    """The persistent arrays the scene keeps for ``crack_lists``."""
+
+    def __init__(self):
+        self.nslot = np.full((2, NNX * NNX), -1, dtype=np.int64)
+        self.cstart = np.zeros((2, NCX * NCY), dtype=np.int64)
+        self.cnear = np.zeros(NCX * NCY, dtype=np.uint8)
+        self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)
+
+    def build(self, c):
+        self.chords, self.cnodes = K.crack_lists(
+            c["cp"], c["cfirst"], c["clast"], c["cext0"], c["cext1"], c["ccrack"], GEOM, NCX,
+            NCY, NNX, self.nslot, self.cstart, self.cnear, self.cbox)
+        return self
 
 
 def _crack(xs, y):
     px = np.asarray(xs, dtype=float)
-    py = np.full(px.size, y)
-    return dict(px=px, py=py, first_of=np.array([0]), last_of=np.array([px.size - 1]),
-                ext_start=np.array([False]), ext_end=np.array([False]),
-                crack_of=np.zeros(px.size, dtype=np.int64))
+    return dict(cp=np.vstack([px, np.full(px.size, y)]), cfirst=np.array([0]),
+                clast=np.array([px.size - 1]), cext0=np.array([False]),
+                cext1=np.array([False]), ccrack=np.zeros(px.size, dtype=np.int64))
 
 
-def _field(c, x, y, nx, ny):
-    st, ch = fields.cell_segments(c["px"], c["py"], c["first_of"], c["last_of"],
-                                  c["ext_start"], c["ext_end"], c["crack_of"], GEOM, NCX, NCY)
-    cell = int(np.floor(y - GEOM[1])) * NCX + int(np.floor(x - GEOM[0]))
-    return fields.particle_node_field(x, y, nx, ny, cell, st, ch, c["px"], c["py"],
-                                      c["first_of"], c["last_of"], c["ext_start"],
-                                      c["ext_end"], c["crack_of"])
+def _cell(x, y):
+    return int(np.floor(y - GEOM[1])) * NCX + int(np.floor(x - GEOM[0]))
 
 
-def test_chord_lists_cover_cells_near_the_crack_only():
+def _field(c, lists, x, y, nx, ny):
+    node = int(round(ny - GEOM[1])) * NNX + int(round(nx - GEOM[0]))
+    f, *_ = K._pair_field(x, y, nx, ny, node, _cell(x, y), lists.cstart, lists.chords,
+                          c["cp"][0], c["cp"][1], c["cfirst"], c["clast"], c["cext0"],
+                          c["cext1"], c["ccrack"], lists.nslot, 2)
+    return f
+
+
+def test_chord_lists_cover_cells_near_the_crack_only_and_follow_it():
     c = _crack([1.2, 3.2, 5.2], 2.01)
-    st, ch = fields.cell_segments(c["px"], c["py"], c["first_of"], c["last_of"],
-                                  c["ext_start"], c["ext_end"], c["crack_of"], GEOM, NCX, NCY)
-    per_cell = np.diff(st)
-    near = (3 + 1) * NCX + (2 + 1)      # cell holding (2.5, 3.5)
-    far = (9 + 1) * NCX + (9 + 1)       # cell holding (9.5, 9.5)
-    assert per_cell[near] == 2 and per_cell[far] == 0
+    lists = Lists().build(c)
+    per_cell = lists.cstart[1] - lists.cstart[0]
+    assert per_cell[_cell(2.5, 2.5)] == 2 and per_cell[_cell(9.5, 9.5)] == 0
+    assert lists.cnear[_cell(2.5, 4.5)] == 1 and lists.cnear[_cell(9.5, 9.5)] == 0
+    slotted = set(lists.cnodes.tolist())
+    assert int(round(2.0 - GEOM[1])) * NNX + int(round(2.0 - GEOM[0])) in slotted
+    # moved far away, the crack leaves nothing behind in its old cells and nodes
+    c["cp"][1] += 6.0
+    lists.build(c)
+    per_cell = lists.cstart[1] - lists.cstart[0]
+    assert per_cell[_cell(2.5, 2.5)] == 0 and per_cell[_cell(2.5, 8.5)] == 2
+    assert lists.cnear[_cell(2.5, 2.5)] == 0
+    assert np.all(lists.nslot[0, : 3 * NNX] == -1)
+    assert set(lists.cnodes.tolist()) == set(np.flatnonzero(lists.nslot[0] >= 0).tolist())
 
 
 def test_field_is_one_across_the_crack_and_zero_beside_or_beyond_the_tip():
     c = _crack([1.2, 3.2, 5.2], 2.01)
-    assert _field(c, 2.5, 2.5, 2.0, 2.0) == 1      # line crosses y = 2.01
-    assert _field(c, 2.5, 2.5, 2.0, 3.0) == 0      # same side
-    assert _field(c, 6.5, 2.5, 6.0, 2.0) == 0      # beyond the tip at x = 5.2
+    lists = Lists().build(c)
+    assert _field(c, lists, 2.5, 2.5, 2.0, 2.0) == 1      # line crosses y = 2.01
+    assert _field(c, lists, 2.5, 2.5, 2.0, 3.0) == 0      # same side
+    assert _field(c, lists, 5.5, 2.5, 6.0, 2.0) == 0      # beyond the tip at x = 5.2
 
 
 def test_contact_stops_approach_without_changing_total_momentum():
-    g = np.zeros((2, 5, 1))
-    g[0, 0, 0], g[1, 0, 0] = 2.0, 1.0                 # masses
-    g[0, 2, 0], g[1, 2, 0] = 2.0 * -1.0, 1.0 * 0.5    # field 0 moves down onto field 1
-    gu = np.zeros((2, 2, 1))
-    normal = np.array([[0.0], [-1.0]])                # above -> below is -y
-    above = np.array([0], dtype=np.int64)             # field 0 is the above side
-    total = g[0, 1:3, 0] + g[1, 1:3, 0]
-    fields.contact(g, gu, normal, above, 0.01, False, 0.0, 1.0)
-    va = g[0, 2, 0] / g[0, 0, 0]
-    vb = g[1, 2, 0] / g[1, 0, 0]
-    assert np.isclose(va, vb)                         # normal velocities equal: no approach
-    assert np.allclose(g[0, 1:3, 0] + g[1, 1:3, 0], total)
+    g = np.zeros((2, K.NR, 1))
+    g[0, K.GM, 0], g[1, K.GM, 0] = 2.0, 1.0                  # masses: 0 above, 1 below
+    g[0, K.GPY, 0], g[1, K.GPY, 0] = 2.0 * -1.0, 1.0 * 0.5   # field 0 moves down onto 1
+    g[0, K.GUY, 0] = 2.0 * -0.01                             # and already overlaps it
+    g[1, K.GNY, 0] = -1.0                                    # normal above -> below: -y
+    g[1, K.GSD, 0] = -1.0                                    # field 1's particles: below
+    gv = np.zeros((2, 2, 1))
+    nslot = np.array([[0], [-1]], dtype=np.int64)
+    cnodes = np.array([0], dtype=np.int64)
+    total = g[0, K.GPX:K.GPY + 1, 0] + g[1, K.GPX:K.GPY + 1, 0]
+    K.contact(g, gv, nslot, cnodes, 0.01, False, False, 0.0, GEOM)
+    va = g[0, K.GPY, 0] / g[0, K.GM, 0]
+    vb = g[1, K.GPY, 0] / g[1, K.GM, 0]
+    assert np.isclose(va, vb)                                # no approach left
+    assert np.allclose(g[0, K.GPX:K.GPY + 1, 0] + g[1, K.GPX:K.GPY + 1, 0], total)
+    assert np.isclose(gv[0, 1, 0], va) and np.isclose(gv[1, 1, 0], vb)
     # separating fields are left alone
-    g[0, 2, 0], g[1, 2, 0] = 2.0 * 1.0, 1.0 * -0.5
+    g[0, K.GPY, 0], g[1, K.GPY, 0] = 2.0 * 1.0, 1.0 * -0.5
     before = g.copy()
-    fields.contact(g, gu, normal, above, 0.01, False, 0.0, 1.0)
+    K.contact(g, gv, nslot, cnodes, 0.01, False, False, 0.0, GEOM)
     assert np.array_equal(g, before)

@@ -38,7 +38,7 @@ from numba import njit, prange
 from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, _stress_update, _store_weights  # KERNEL-BASE
 from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
 from nairnmpm_py.cracks.crossing import segment_crossing_side
-from nairnmpm_py.cracks.fields import _chord, _chord_cells
+from nairnmpm_py.cracks.chords import _chord, _chord_cells
 
 STATUS_CRACK_LEFT_GRID = 4
 

@@ -143,7 +143,7 @@ def _load_source(source: str, prefix: str, refs: list[str]):
 
 CRACK_BASE_MARKER = "# KERNEL-BASE"
 TRACTION_MARKER = "# KERNEL-TRACTION"
-CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.fields:x"]
+CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.chords:x"]
 
 
 def _traction_source(functions: list[str]) -> str:
