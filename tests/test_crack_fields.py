@@ -19,7 +19,7 @@ class Lists:
         self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)
 
     def build(self, c):
-        self.chords, self.cnodes = K.crack_lists(
+        self.chords, self.cxy, self.cnodes = K.crack_lists(
             c["cp"], c["cfirst"], c["clast"], c["cext0"], c["cext1"], c["ccrack"], GEOM, NCX,
             NCY, NNX, self.nslot, self.cstart, self.cnear, self.cbox)
         return self
@@ -38,7 +38,7 @@ def _cell(x, y):
 
 def _field(c, lists, x, y, nx, ny):
     node = int(round(ny - GEOM[1])) * NNX + int(round(nx - GEOM[0]))
-    f, *_ = K._pair_field(x, y, nx, ny, node, _cell(x, y), lists.cstart, lists.chords,
+    f, *_ = K._pair_field(x, y, nx, ny, node, _cell(x, y), lists.cstart, lists.chords, lists.cxy,
                           c["cp"][0], c["cp"][1], c["cfirst"], c["clast"], c["cext0"],
                           c["cext1"], c["ccrack"], lists.nslot, 2)
     return f
@@ -49,6 +49,10 @@ def test_chord_lists_cover_cells_near_the_crack_only_and_follow_it():
     lists = Lists().build(c)
     per_cell = lists.cstart[1] - lists.cstart[0]
     assert per_cell[_cell(2.5, 2.5)] == 2 and per_cell[_cell(9.5, 9.5)] == 0
+    # each entry carries its chord's end points
+    q = lists.cstart[0, _cell(2.5, 2.5)]
+    k = lists.chords[q]
+    assert np.array_equal(lists.cxy[q], [c["cp"][0, k], c["cp"][1, k], c["cp"][0, k + 1], c["cp"][1, k + 1]])
     assert lists.cnear[_cell(2.5, 4.5)] == 1 and lists.cnear[_cell(9.5, 9.5)] == 0
     slotted = set(lists.cnodes.tolist())
     assert int(round(2.0 - GEOM[1])) * NNX + int(round(2.0 - GEOM[0])) in slotted

@@ -58,7 +58,7 @@ C_CONFLICT, C_LOST, C_FAILED, C_BLOCKED = 0, 1, 2, 3
 
 # ---- field choice -------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _pair_field(x, y, xn, yn, node, cell, cstart, chords, cpx, cpy, cfirst, clast, cext0,
+def _pair_field(x, y, xn, yn, node, cell, cstart, chords, cxy, cpx, cpy, cfirst, clast, cext0,
                 cext1, ccrack, nslot, nf):
     """Velocity field of the particle (x, y) at a node (xn, yn): 1 bit per slot whose
     crack the particle-node line crosses an odd number of times.  Also returns, per
@@ -73,8 +73,7 @@ def _pair_field(x, y, xn, yn, node, cell, cstart, chords, cpx, cpy, cfirst, clas
     bad = 0
     for q in range(cstart[0, cell], cstart[1, cell]):
         k = chords[q]
-        x3, y3, x4, y4 = _chord(k, cpx, cpy, cfirst, clast, cext0, cext1, ccrack)
-        hit = segment_crossing_side(x, y, xn, yn, x3, y3, x4, y4)
+        hit = segment_crossing_side(x, y, xn, yn, cxy[q, 0], cxy[q, 1], cxy[q, 2], cxy[q, 3])
         if hit == 0:
             continue
         c = ccrack[k]
@@ -108,7 +107,7 @@ def _cell_of(x, y, geom, ncx, ncy):
 
 @njit(cache=True, inline="always")
 def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, cut, nnx, ncx, ncy,
-                      cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                      cstart, chords, cxy, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
                       nslot, nf, use_position, conflicts):
     """Field choice at each node of particle p, then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
@@ -154,7 +153,7 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, cut, nn
             if slotted and has_chords:
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
-                f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords,
+                f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords, cxy,
                                                      cpx, cpy, cfirst, clast, cext0, cext1,
                                                      ccrack, nslot, nf)
                 conflicts += bad
@@ -188,7 +187,7 @@ def _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld, cut, nn
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
 def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
-                     cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                     cstart, chords, cxy, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
                      nslot, nf, use_position, counts):
     n = pos.shape[1]
     nnx = int(geom[4])
@@ -205,7 +204,7 @@ def weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, n
         for p in range(lo, hi):
             _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
             conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
-                                          cut, nnx, ncx, ncy, cstart, chords, cnear, cpx, cpy,
+                                          cut, nnx, ncx, ncy, cstart, chords, cxy, cnear, cpx, cpy,
                                           cfirst, clast, cext0, cext1, ccrack, nslot, nf,
                                           use_position, conflicts)
         counts[c] = conflicts
@@ -642,7 +641,7 @@ def crack_frame(k, cpx, cpy, ccrack, cfirst, clast):
 
 
 @njit(cache=True, inline="always")
-def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy, cfirst,
+def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy, cpx, cpy, cfirst,
                    clast, cext0, cext1, ccrack, nslot, nf, nodes, fields, weights, g, tested):
     """Classic linear shape functions at a crack surface point and the field on the
     surface's side at each of the four nodes; weights are S * m of that field (0 when
@@ -672,7 +671,7 @@ def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
                 f, k0, s0, k1, s1, bad = _pair_field(tx_, ty_, xn, yn, node, cell, cstart,
-                                                     chords, cpx, cpy, cfirst, clast, cext0,
+                                                     chords, cxy, cpx, cpy, cfirst, clast, cext0,
                                                      cext1, ccrack, nslot, nf)
                 fields[q] = f
                 weights[q] = s * g[f, GM, node]
@@ -741,7 +740,7 @@ def _mirror_surface_nodes(sx, sy, geom, crack, nslot, nf, ref_nodes, ref_fields,
 
 
 @njit(cache=True, inline="always")
-def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy,
+def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy, cpx, cpy,
                 cfirst, clast, cext0, cext1, ccrack, nslot, nf, g, nodes, fields, weights,
                 tested, ref_nodes, ref_fields, ref_tested):
     """Nodes, fields and weights of one surface of crack particle k: the second surface
@@ -752,7 +751,7 @@ def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cp
         total = _mirror_surface_nodes(sx, sy, geom, ccrack[k], nslot, nf, ref_nodes,
                                       ref_fields, ref_tested, nodes, fields, weights, g)
     if total < 0.0:
-        total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cpx, cpy,
+        total = _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy, cpx, cpy,
                                cfirst, clast, cext0, cext1, ccrack, nslot, nf, nodes, fields,
                                weights, g, tested)
         if side == 0:
@@ -763,7 +762,7 @@ def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cp
 
 
 @njit(cache=True, error_model="numpy")
-def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0, cext1,
+def crack_tractions(g, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, clast, cext0, cext1,
                     ccrack, nslot, claw, cstate, chist, law1, law2, thickness, counts):
     """Traction forces of the law particles on both surfaces' fields (the force is
     shared by S * m, all of it delivered), with history, unloading to the origin and
@@ -820,7 +819,7 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords,
+            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy,
                                 cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf, g,
                                 nodes, fields, weights, tested, ref_nodes, ref_fields,
                                 ref_tested)
@@ -834,7 +833,7 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast
 
 
 @njit(cache=True, error_model="numpy")
-def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
+def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, clast, cext0,
                 cext1, ccrack, cfixed, nslot, dt, bounds, counts):
     """Each surface moves with the mean of the old and new velocity of the field on its
     side (mass-weighted, classic shape functions); a side that finds no field copies
@@ -862,7 +861,7 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
             sgn = 1.0 if side == 0 else -1.0
             sx = ca[0, k] if side == 0 else cb[0, k]
             sy = ca[1, k] if side == 0 else cb[1, k]
-            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords,
+            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy,
                                 cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf, g,
                                 nodes, fields, weights, tested, ref_nodes, ref_fields,
                                 ref_tested)
@@ -915,7 +914,7 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, 
 def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                            plane_stress, geom, ga, gvn, dt, dt_stress, damping, pdamp, bounds,
                            vmax, left, bad, wij, wc, vfld, cut, gbuf, nch, ncx, ncy, cstart,
-                           chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                           chords, cxy, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
                            use_position, counts):
     """Grid -> particles from each particle's own fields, then its new weights, fields
     (crossing the moved cracks) and mass and momentum back to the grid."""
@@ -1007,7 +1006,7 @@ def update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, ma
                     bad[c, 1] = STATUS_RUNAWAY
             _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
             conflicts = _scatter_particle(p, buf, pos, pos0, vel, mass, geom, wij, wc, vfld,
-                                          cut, nnx, ncx, ncy, cstart, chords, cnear, cpx, cpy,
+                                          cut, nnx, ncx, ncy, cstart, chords, cxy, cnear, cpx, cpy,
                                           cfirst, clast, cext0, cext1, ccrack, nslot, nf,
                                           use_position, conflicts)
         counts[c] = conflicts
@@ -1031,6 +1030,7 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
     j0, j1, kept between calls so the previous box is cleared first), so the cost
     follows the crack, not the grid.  ``cstart[0, cell]`` to ``cstart[1, cell]`` index
     the cell's chords in the returned ``chords``; every other cell has an empty range.
+    ``cxy`` holds each entry's chord end points.
     ``cnear`` marks cells within NEAR_CELLS of a cell with chords; ``nslot`` holds a
     node's two lowest-numbered cracks listed in a cell next to it (-1 none).
     """
@@ -1070,7 +1070,7 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
     cbox[2] = j_lo
     cbox[3] = j_hi
     if i_lo > i_hi:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        return (np.zeros(0, dtype=np.int64), np.zeros((0, 4)), np.zeros(0, dtype=np.int64))
     bw = i_hi - i_lo + 1
     count = np.zeros(bw * (j_hi - j_lo + 1) + 1, dtype=np.int64)
     for k in range(n - 1):
@@ -1137,7 +1137,16 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
             if a >= 0:
                 cnodes[nc] = node
                 nc += 1
-    return chords, cnodes[:nc]
+    # each listed chord's end points (exterior ends extended), next to its entry, so
+    # the crossing tests read them in order
+    cxy = np.empty((chords.size, 4))
+    for q in range(chords.size):
+        x3, y3, x4, y4 = _chord(chords[q], px, py, cfirst, clast, cext0, cext1, ccrack)
+        cxy[q, 0] = x3
+        cxy[q, 1] = y3
+        cxy[q, 2] = x4
+        cxy[q, 3] = y4
+    return chords, cxy, cnodes[:nc]
 
 
 @njit(cache=True, error_model="numpy")
@@ -1149,15 +1158,17 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
             law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cstart,
-            cnear, cbox, counts, chunk_counts, resume, flush, pend, chords_now, cnodes_now):
+            cnear, cbox, counts, chunk_counts, resume, flush, pend, chords_now, cxy_now,
+            cnodes_now):
     """Run up to ``nsteps`` steps of a scene with cracks from time ``t`` (ms).
 
     Order per step: loads and internal forces into each particle's fields; crack
     tractions; contact after the update; velocity conditions; cracks moved; particles
     updated and extrapolated to the next step's fields (crossing the moved cracks);
     contact on the new momenta; velocity conditions.  Returns (steps done, status,
-    offending particle or crack particle, chords, crack nodes): the last two are the
-    crack lists of the last extrapolation, passed back in for a resumed call.
+    offending particle or crack particle, chords, chord ends, crack nodes): the last
+    three are the crack lists of the last extrapolation, passed back in for a resumed
+    call.
 
     ``resume``: the previous call's last extrapolation is still current (no crack grew,
     nothing changed), so it is not redone.  ``flush``: apply the carried USAVG+ / USL+
@@ -1195,12 +1206,13 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           rec_ftime, rec_force, rec_work, sym_out, sym_in, sym_dir, bad, nch,
                           cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate,
                           chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut,
-                          wij, wc, nslot, cbox, counts, chunk_counts, cstart, chords_now, cnodes_now,
-                          cnear, ncx, ncy, nnx, n)
-    chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx,
-                                 nslot, cstart, cnear, cbox)
+                          wij, wc, nslot, cbox, counts, chunk_counts, cstart, chords_now,
+                          cxy_now, cnodes_now, cnear, ncx, ncy, nnx, n)
+    chords, cxy, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
+                                      nnx, nslot, cstart, cnear, cbox)
     weights_and_mass(pos, pos0, vel, mass, lp, geom, wij, wc, vfld, cut, gbuf, nch, ncx, ncy,
-                     cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                     cstart, chords, cxy, cnear, cpx, cpy, cfirst, clast, cext0, cext1, ccrack,
+                     nslot,
                      g.shape[0], use_position, chunk_counts)
     for c in range(nch):
         counts[C_CONFLICT] += chunk_counts[c]
@@ -1216,7 +1228,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                       rec_work, sym_out, sym_in, sym_dir, bad, nch, cp, ca, cb, cfirst, clast,
                       cext0, cext1, ccrack, cfixed, claw, cstate, chist, law1, law2, thickness,
                       use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cbox, counts,
-                      chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx, n)
+                      chunk_counts, cstart, chords, cxy, cnodes, cnear, ncx, ncy, nnx, n)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1227,7 +1239,8 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work, sym_out, sym_in,
                sym_dir, bad, nch, cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw,
                cstate, chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij,
-               wc, nslot, cbox, counts, chunk_counts, cstart, chords, cnodes, cnear, ncx, ncy, nnx,
+               wc, nslot, cbox, counts, chunk_counts, cstart, chords, cxy, cnodes, cnear, ncx, ncy,
+               nnx,
                n):
     """The steps themselves, from a current extrapolation.  Without ``flush`` the last
     step's carried USAVG+ stress half is returned in ``pend`` instead of applied."""
@@ -1247,7 +1260,7 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                      wc, vfld, cut, gv, gbuf, nch, pending, dt_first, True, n)
         pending = 0.0
         reduce_forces(gbuf, g, nch, cnodes)
-        crack_tractions(g, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast, cext0,
+        crack_tractions(g, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, clast, cext0,
                         cext1, ccrack, nslot, claw, cstate, chist, law1, law2, thickness,
                         counts)
         contact(g, gv, nslot, cnodes, dt, True, use_position, cutoff_cells, geom)
@@ -1255,17 +1268,17 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
         velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec,
                                   rec_style, rec_value, rec_t0, rec_ftime, rec_force,
                                   rec_work, sym_out, sym_in, sym_dir, t, dt)
-        out = move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cp, ca, cb, cfirst, clast,
-                          cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
+        out = move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst,
+                          clast, cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
         if out >= 0:
-            return step + 1, STATUS_CRACK_LEFT_GRID, out, chords, cnodes
+            return step + 1, STATUS_CRACK_LEFT_GRID, out, chords, cxy, cnodes
         old_cnodes = cnodes
-        chords, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
+        chords, cxy, cnodes = crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy,
                                      nnx, nslot, cstart, cnear, cbox)
         update_and_extrapolate(pos, pos0, vel, mass, lp, mat, F, stress, hist, w, mat_params,
                                plane_stress, geom, ga, gvn, dt, dt_update, damping, pdamp,
                                bounds, vmax, left, bad, wij, wc, vfld, cut, gbuf, nch, ncx,
-                               ncy, cstart, chords, cnear, cpx, cpy, cfirst, clast, cext0,
+                               ncy, cstart, chords, cxy, cnear, cpx, cpy, cfirst, clast, cext0,
                                cext1, ccrack, nslot, use_position, chunk_counts)
         for c in range(nch):
             counts[C_CONFLICT] += chunk_counts[c]
@@ -1303,5 +1316,5 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                 stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
                              geom, wij, wc, vfld, cut, gv, gbuf, nch, 0.0, pending, False, n)
             if status != STATUS_OK:
-                return step + 1, status, who, chords, cnodes
-    return nsteps, STATUS_OK, -1, chords, cnodes
+                return step + 1, status, who, chords, cxy, cnodes
+    return nsteps, STATUS_OK, -1, chords, cxy, cnodes

@@ -109,6 +109,7 @@ class CrackScene:
         self.grid_current = False      # the next call must extrapolate
         self.pend = np.zeros(1)        # USAVG+ stress half carried between calls
         self.chords_now = np.zeros(0, dtype=np.int64)   # crack lists of the last call
+        self.cxy_now = np.zeros((0, 4))
         self.cnodes_now = np.zeros(0, dtype=np.int64)
         if self.growing:
             # NairnMPM checks for growth every CFL * cell / wave speed (at least a step)
@@ -136,7 +137,7 @@ class CrackScene:
         c = sim.cond_arrays
         cs = self.cracks
         use_position = self.contact_position is not None
-        done, status, who, self.chords_now, self.cnodes_now = self.kernels.advance(
+        done, status, who, self.chords_now, self.cxy_now, self.cnodes_now = self.kernels.advance(
             nsteps, sim.time, sim.dt, sim.method, sim.post_extrapolate, sim.plane_stress,
             p.pos, p.pos0, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress, p.hist, p.w,
             p.pdamp, sim.mat_params, sim.geom, sim.bounds, self.g, self.gbuf, self.gv,
@@ -149,7 +150,7 @@ class CrackScene:
             self.law1, self.law2, float(sim.grid.thickness), use_position,
             float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
             self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush, self.pend,
-            self.chords_now, self.cnodes_now)
+            self.chords_now, self.cxy_now, self.cnodes_now)
         return done, status, who
 
     # ---- zone and traction work -------------------------------------------------------
