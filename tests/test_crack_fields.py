@@ -96,3 +96,14 @@ def test_contact_stops_approach_without_changing_total_momentum():
     before = g.copy()
     K.contact(g, gv, nslot, cnodes, 0.01, False, False, 0.0, GEOM)
     assert np.array_equal(g, before)
+
+
+def test_no_chord_joins_two_cracks():
+    c = dict(cp=np.array([[1.2, 3.2, 5.2, 1.2, 3.2], [2.01, 2.01, 2.01, 6.01, 6.01]]),
+             cfirst=np.array([0, 3]), clast=np.array([2, 4]),
+             cext0=np.array([False, False]), cext1=np.array([False, False]),
+             ccrack=np.array([0, 0, 0, 1, 1], dtype=np.int64))
+    lists = Lists().build(c)
+    assert sorted(set(lists.chords.tolist())) == [0, 1, 3]
+    # nodes between the two cracks have both in their slots only where both are near
+    assert np.all(lists.nslot[0, lists.cnodes] >= 0)

@@ -499,39 +499,25 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
                 L01 = 0.0
                 L10 = 0.0
                 L11 = 0.0
-                # the branch on ``cut`` is taken once per particle, not per node, so
-                # the uncut particles run the same loop as the no-crack step
-                if cp_:
-                    for b in range(NA):
-                        sy = r[3 + b]
-                        dy = r[9 + b]
-                        row = (j0 + b) * nnx + i0
-                        for a in range(NA):
-                            k = row + a
-                            gx = r[6 + a] * sy
-                            gy = r[a] * dy
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        if cp_:
                             f = vfld[p, b * NA + a]
                             vx = gv[f, 0, k]
                             vy = gv[f, 1, k]
-                            L00 += vx * gx
-                            L01 += vx * gy
-                            L10 += vy * gx
-                            L11 += vy * gy
-                else:
-                    for b in range(NA):
-                        sy = r[3 + b]
-                        dy = r[9 + b]
-                        row = (j0 + b) * nnx + i0
-                        for a in range(NA):
-                            k = row + a
-                            gx = r[6 + a] * sy
-                            gy = r[a] * dy
+                        else:
                             vx = gv0[0, k]
                             vy = gv0[1, k]
-                            L00 += vx * gx
-                            L01 += vx * gy
-                            L10 += vy * gx
-                            L11 += vy * gy
+                        L00 += vx * gx
+                        L01 += vx * gy
+                        L10 += vy * gx
+                        L11 += vy * gy
                 if dt_pre > 0.0:
                     _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
                                    mat_params, plane_stress)
@@ -544,27 +530,19 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
             sxx = stress[0, p] * vol
             syy = stress[1, p] * vol
             sxy = stress[2, p] * vol
-            if cp_:
-                for b in range(NA):
-                    sy = r[3 + b]
-                    dy = r[9 + b]
-                    row = (j0 + b) * nnx + i0
-                    for a in range(NA):
-                        k = row + a
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    gx = r[6 + a] * sy
+                    gy = r[a] * dy
+                    if cp_:
                         fb = buf[vfld[p, b * NA + a]]
                         fb[GFX, k] -= sxx * gx + sxy * gy
                         fb[GFY, k] -= sxy * gx + syy * gy
-            else:
-                for b in range(NA):
-                    sy = r[3 + b]
-                    dy = r[9 + b]
-                    row = (j0 + b) * nnx + i0
-                    for a in range(NA):
-                        k = row + a
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
+                    else:
                         b0[GFX, k] -= sxx * gx + sxy * gy
                         b0[GFY, k] -= sxy * gx + syy * gy
 
@@ -1050,17 +1028,24 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
             for i in range(cbox[0], min(cbox[1] + 2, nnx)):
                 nslot[0, j * nnx + i] = -1
                 nslot[1, j * nnx + i] = -1
-    # the new box
+    # the new box, from each chord's cells (kept for the two passes below)
     n = px.size
+    ranges = np.zeros((max(n - 1, 0), 4), dtype=np.int64)
+    ranges[:, 1] = -1                     # empty (i0 > i1) unless set below
+    ranges[:, 3] = -1
     i_lo = ncx
     i_hi = -1
     j_lo = ncy
     j_hi = -1
     for k in range(n - 1):
         if ccrack[k] != ccrack[k + 1]:
-            continue
+            continue                      # no chord between two cracks
         i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
                                       ncx, ncy)
+        ranges[k, 0] = i0
+        ranges[k, 1] = i1
+        ranges[k, 2] = j0
+        ranges[k, 3] = j1
         i_lo = min(i_lo, i0)
         i_hi = max(i_hi, i1)
         j_lo = min(j_lo, j0)
@@ -1074,12 +1059,8 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
     bw = i_hi - i_lo + 1
     count = np.zeros(bw * (j_hi - j_lo + 1) + 1, dtype=np.int64)
     for k in range(n - 1):
-        if ccrack[k] != ccrack[k + 1]:
-            continue
-        i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
-                                      ncx, ncy)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
+        for j in range(ranges[k, 2], ranges[k, 3] + 1):
+            for i in range(ranges[k, 0], ranges[k, 1] + 1):
                 count[(j - j_lo) * bw + i - i_lo + 1] += 1
     for q in range(count.size - 1):
         count[q + 1] += count[q]
@@ -1091,12 +1072,8 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
             cstart[0, cell] = count[b]
             cstart[1, cell] = count[b]
     for k in range(n - 1):
-        if ccrack[k] != ccrack[k + 1]:
-            continue
-        i0, i1, j0, j1 = _chord_cells(k, px, py, cfirst, clast, cext0, cext1, ccrack, geom,
-                                      ncx, ncy)
-        for j in range(j0, j1 + 1):
-            for i in range(i0, i1 + 1):
+        for j in range(ranges[k, 2], ranges[k, 3] + 1):
+            for i in range(ranges[k, 0], ranges[k, 1] + 1):
                 cell = j * ncx + i
                 chords[cstart[1, cell]] = k
                 cstart[1, cell] += 1
