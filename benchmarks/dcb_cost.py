@@ -144,17 +144,23 @@ def main() -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    for shape, marker in (("uGIMP", "o-"), ("linear", "s--")):
+    for shape, marker, color in (("uGIMP", "o", "C0"), ("linear", "s", "C1")):
         sel = [r for r in rows if r["shape"] == shape]
         if not sel:
             continue
-        ax.plot([r["wall_seconds"] for r in sel], [r["R_minus_eq22_rms_pct_of_Jtipc"] for r in sel],
-                marker, label=shape)
-        for r in sel:
-            ax.annotate(f"{r['spacing_mm']:g} mm", (r["wall_seconds"], r["R_minus_eq22_rms_pct_of_Jtipc"]),
+        x = [r["wall_seconds"] for r in sel]
+        y = [r["R_minus_eq22_rms_pct_of_Jtipc"] for r in sel]
+        ax.plot(x, y, "-" if shape == "uGIMP" else "--", color=color, label=shape)
+        for r, xv, yv in zip(sel, x, y):
+            failed = r["exit_status"] != "done"
+            # a run that stopped (exit 3) is drawn hollow: its R curve is partial
+            ax.plot([xv], [yv], marker, color=color, mfc="none" if failed else color)
+            ax.annotate(f"{r['spacing_mm']:g} mm" + (" (exit 3)" if failed else ""), (xv, yv),
                         textcoords="offset points", xytext=(4, 4), fontsize="small")
     ax.set_xscale("log")
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel(f"wall time (s, {args.threads} threads)")
     ax.set_ylabel("RMS of R - Eq 22 (% of J_tip,c)")
     ax.set_title("Bridging DCB (sigma_c = 0.5 MPa): R-curve error against cost")
