@@ -114,3 +114,19 @@ def test_run_sweep_function_returns_statuses_in_table_order(tmp_path):
     res = run_sweep(template, rows, tmp_path / "s", workers=1)
     assert [r["name"] for r in res] == ["one"] and res[0]["exit_status"] == "done"
     assert res[0]["steps"] > 5 and (tmp_path / "s" / "summary.csv").exists()
+
+
+def test_sweep_plots_overlay_crack_results(tmp_path):
+    """Members with cracks.csv get J_tip / growth and R-curve overlays."""
+    from nairnmpm_py.analysis.sweep_plots import plot_sweep
+    (tmp_path / "summary.csv").write_text("name,exit_status\na,done\nb,done\n")
+    head = "time_ms,crack,tip,crack_growth_mm,J_tip_J_m2,R_J_m2,event\n"
+    for name, jc in (("a", 100.0), ("b", 200.0)):
+        d = tmp_path / name
+        d.mkdir()
+        (d / "global.csv").write_text("time_ms,step,kinetic_energy_J\n0,0,0\n1,10,1e-3\n")
+        rows = [f"{t},1,\"end\",0,{jc * t / 2},,\"archive\"" for t in (0.0, 1.0)]
+        rows += [f"{1 + k / 10},1,\"end\",{k * 0.5},{jc},{jc + 10 * k},\"growth\"" for k in range(5)]
+        (d / "cracks.csv").write_text(head + "\n".join(rows) + "\n")
+    written = {p.name for p in plot_sweep(tmp_path)}
+    assert {"sweep_cracks.png", "sweep_r_curve.png", "sweep_energies.png"} <= written

@@ -1,10 +1,13 @@
 """Overlay plots of a sweep folder (``summary.csv`` plus one results folder per member):
-energies against time and each load against displacement (or time), one line per
+energies against time, each load against displacement (or time) and, for members with
+cracks, J_tip and crack growth against time and R against crack growth; one line per
 member, legend by member name."""
 from __future__ import annotations
 
 import csv
 from pathlib import Path
+
+import numpy as np
 
 from .plots import (DISP_PREFIX, ENERGY_COLUMNS, LOAD_PREFIXES, TIME_LABEL, _figure,
                     _nonzero, _safe, _save)
@@ -79,4 +82,48 @@ def plot_sweep(folder, out_folder=None) -> list[Path]:
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
         _save(fig, out / f"sweep_load_{_safe(bc)}.png", written)
+    _plot_crack_overlays(folder, [name for name, _, _ in members], out, written)
     return written
+
+
+def _plot_crack_overlays(folder: Path, names: list[str], out: Path, written: list[Path]) -> None:
+    """``sweep_cracks.png``: J_tip and crack growth against time (first tip of each
+    member); ``sweep_r_curve.png``: R (Eq 15) against growth at the growth steps."""
+    tables = []
+    for name in names:
+        path = folder / name / "cracks.csv"
+        if not path.exists():
+            continue
+        try:
+            _, c = read_csv_columns(path)
+        except Exception:
+            continue
+        if "time_ms" not in c or not len(c["time_ms"]):
+            continue
+        first = (c["crack"] == c["crack"][0]) & (c["tip"] == c["tip"][0])
+        tables.append((name, {k: v[first] for k, v in c.items()}))
+    if not tables:
+        return
+    fig, axes = _figure(2)
+    for name, c in tables:
+        order = np.argsort(c["time_ms"], kind="stable")
+        axes[0].plot(c["time_ms"][order], c["J_tip_J_m2"][order], label=name)
+        axes[1].plot(c["time_ms"][order], c["crack_growth_mm"][order], label=name)
+    axes[0].set_ylabel("J_tip (J/m^2)")
+    axes[1].set_ylabel("crack growth (mm)")
+    for ax in axes:
+        ax.set_xlabel(TIME_LABEL)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize="small")
+    _save(fig, out / "sweep_cracks.png", written)
+    grown = [(n, c) for n, c in tables if np.any(c["event"] == "growth")]
+    if grown:
+        fig, (ax,) = _figure()
+        for name, c in grown:
+            g = c["event"] == "growth"
+            ax.plot(c["crack_growth_mm"][g], c["R_J_m2"][g], ".-", ms=3, label=name)
+        ax.set_xlabel("crack growth (mm)")
+        ax.set_ylabel("R (J/m^2)")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+        _save(fig, out / "sweep_r_curve.png", written)
