@@ -65,6 +65,9 @@ class CrackScene:
         self.check_steps = 1
         self.growth_log: list[dict] = []
         self.j_conflicts = 0      # J-field particle-node pairs on a crack line (field 0)
+        self._subset = np.zeros(0, dtype=np.int64)   # particles near the J window
+        self._subset_window = None
+        self._subset_age = 0
 
     # ---- kernel side ---------------------------------------------------------------
     def prepare(self, sim) -> None:
@@ -258,8 +261,8 @@ class CrackScene:
         changes or every ``WINDOW_REFRESH`` checks, with a margin of a cell more than
         a particle can reach, which no particle crosses in that many steps (a CFL
         step moves a particle well under a tenth of a cell)."""
-        self._subset_age = getattr(self, "_subset_age", 0) + 1
-        if getattr(self, "_subset_window", None) != window or self._subset_age > WINDOW_REFRESH:
+        self._subset_age += 1
+        if self._subset_window != window or self._subset_age > WINDOW_REFRESH:
             g, p = sim.grid, sim.particles
             i0, i1, j0, j1 = window
             reach = 2.5      # cells: uGIMP reach (1.5) plus a cell of margin
