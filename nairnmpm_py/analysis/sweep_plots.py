@@ -24,16 +24,22 @@ def sweep_members(folder) -> list[tuple[str, dict, list[str]]]:
         names = [r["name"] for r in csv.DictReader(f) if r.get("name")]
     members = []
     for name in names:
-        g = folder / name / "global.csv"
-        if not g.exists():
-            continue
-        try:
-            cols, data = read_csv_columns(g)
-        except Exception:
-            continue
-        if "time_ms" in data and len(data["time_ms"]):
+        cols, data = _member_csv(folder / name / "global.csv")
+        if data:
             members.append((name, data, cols))
     return members
+
+
+def _member_csv(path: Path) -> tuple[list[str], dict | None]:
+    """A member's CSV as columns, or (_, None) if it is missing, unreadable or has no
+    rows (a member that failed early)."""
+    if not path.exists():
+        return [], None
+    try:
+        cols, data = read_csv_columns(path)
+    except Exception:
+        return [], None
+    return (cols, data) if "time_ms" in data and len(data["time_ms"]) else ([], None)
 
 
 def plot_sweep(folder, out_folder=None) -> list[Path]:
@@ -91,14 +97,8 @@ def _plot_crack_overlays(folder: Path, names: list[str], out: Path, written: lis
     member); ``sweep_r_curve.png``: R (Eq 15) against growth at the growth steps."""
     tables = []
     for name in names:
-        path = folder / name / "cracks.csv"
-        if not path.exists():
-            continue
-        try:
-            _, c = read_csv_columns(path)
-        except Exception:
-            continue
-        if "time_ms" not in c or not len(c["time_ms"]):
+        _, c = _member_csv(folder / name / "cracks.csv")
+        if c is None:
             continue
         first = (c["crack"] == c["crack"][0]) & (c["tip"] == c["tip"][0])
         tables.append((name, {k: v[first] for k, v in c.items()}))

@@ -619,18 +619,24 @@ def crack_frame(k, cpx, cpy, ccrack, cfirst, clast):
 
 
 @njit(cache=True, inline="always")
+def _surface_cell(sx, sy, geom):
+    """Lower-left node (column, row) of the cell holding a surface point and the
+    point's fractions across it (classic linear shape functions)."""
+    xi = (sx - geom[0]) / geom[2]
+    eta = (sy - geom[1]) / geom[3]
+    i0 = int(math.floor(xi))
+    j0 = int(math.floor(eta))
+    return i0, j0, xi - i0, eta - j0
+
+
+@njit(cache=True, inline="always")
 def _surface_nodes(sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy, cpx, cpy, cfirst,
                    clast, cext0, cext1, ccrack, nslot, nf, nodes, fields, weights, g, tested):
     """Classic linear shape functions at a crack surface point and the field on the
     surface's side at each of the four nodes; weights are S * m of that field (0 when
     the field is empty).  Returns the sum of the weights."""
     nnx = int(geom[4])
-    xi = (sx - geom[0]) / geom[2]
-    eta = (sy - geom[1]) / geom[3]
-    i0 = int(math.floor(xi))
-    j0 = int(math.floor(eta))
-    rx = xi - i0
-    ry = eta - j0
+    i0, j0, rx, ry = _surface_cell(sx, sy, geom)
     # test from just off the plane on the surface's own side
     tx_ = sx + sgn * NUDGE * geom[2] * ux
     ty_ = sy + sgn * NUDGE * geom[3] * uy
@@ -683,12 +689,7 @@ def _mirror_surface_nodes(sx, sy, geom, crack, nslot, nf, ref_nodes, ref_fields,
     Returns -1 when that does not apply (another cell, or a node the first surface
     did not test)."""
     nnx = int(geom[4])
-    xi = (sx - geom[0]) / geom[2]
-    eta = (sy - geom[1]) / geom[3]
-    i0 = int(math.floor(xi))
-    j0 = int(math.floor(eta))
-    rx = xi - i0
-    ry = eta - j0
+    i0, j0, rx, ry = _surface_cell(sx, sy, geom)
     total = 0.0
     q = 0
     for b in range(2):

@@ -13,6 +13,8 @@ import math
 
 from numba import njit
 
+from .crossing import extended_chord
+
 # a chord that cuts a particle-node line lies within the cells next to the particle's
 # cell (uGIMP nodes are at most 1.5 cells away) and within the cells next to the
 # node's four cells, so one cell of padding finds every chord that can matter
@@ -23,19 +25,8 @@ SEARCH_PAD_CELLS = 1
 def _chord(k, px, py, first_of, last_of, ext_start, ext_end, crack_of):
     """End points of chord k (particles k, k+1), exterior ends extended 4x."""
     c = crack_of[k]
-    x3 = px[k]
-    y3 = py[k]
-    x4 = px[k + 1]
-    y4 = py[k + 1]
-    ex = x4 - x3
-    ey = y4 - y3
-    if k == first_of[c] and ext_start[c]:
-        x3 -= 4.0 * ex
-        y3 -= 4.0 * ey
-    if k + 1 == last_of[c] and ext_end[c]:
-        x4 += 4.0 * ex
-        y4 += 4.0 * ey
-    return x3, y3, x4, y4
+    return extended_chord(px[k], py[k], px[k + 1], py[k + 1],
+                          k == first_of[c] and ext_start[c], k + 1 == last_of[c] and ext_end[c])
 
 
 @njit(cache=True, inline="always")

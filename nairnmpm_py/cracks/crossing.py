@@ -72,6 +72,21 @@ def segment_crossing_side(px, py, nx, ny, x3, y3, x4, y4):
     return 0
 
 
+@njit(cache=True, inline="always")
+def extended_chord(x3, y3, x4, y4, extend_start, extend_end):
+    """A chord's end points, an exterior crack end pushed out by four chord lengths so
+    that lines to nodes near the edge of the body still cross it."""
+    ex = x4 - x3
+    ey = y4 - y3
+    if extend_start:
+        x3 -= 4.0 * ex
+        y3 -= 4.0 * ey
+    if extend_end:
+        x4 += 4.0 * ex
+        y4 += 4.0 * ey
+    return x3, y3, x4, y4
+
+
 @njit(cache=True)
 def line_crosses_crack(px, py, nx, ny, seg_x, seg_y, first, count, ext_start, ext_end):
     """Which side of one crack the particle is on, if the p -> n line crosses it.
@@ -88,18 +103,8 @@ def line_crosses_crack(px, py, nx, ny, seg_x, seg_y, first, count, ext_start, ex
     side = 0
     last = first + count - 1
     for k in range(first, last):
-        x3 = seg_x[k]
-        y3 = seg_y[k]
-        x4 = seg_x[k + 1]
-        y4 = seg_y[k + 1]
-        ex = x4 - x3
-        ey = y4 - y3
-        if k == first and ext_start:
-            x3 -= 4.0 * ex
-            y3 -= 4.0 * ey
-        if k == last - 1 and ext_end:
-            x4 += 4.0 * ex
-            y4 += 4.0 * ey
+        x3, y3, x4, y4 = extended_chord(seg_x[k], seg_y[k], seg_x[k + 1], seg_y[k + 1],
+                                        k == first and ext_start, k == last - 1 and ext_end)
         hit = segment_crossing_side(px, py, nx, ny, x3, y3, x4, y4)
         if hit != 0:
             side = hit if side == 0 else 0

@@ -113,14 +113,8 @@ class NodalFields:
     def values(self, node: int, field: int) -> np.ndarray | None:
         """The value vector at (flat grid node, field) for the contour, or None if
         empty."""
-        k = int(self.local(node))
-        if self.mass[field, k] <= 0.0:
-            return None
-        v = np.empty(_NV)
-        v[0:4] = self.grad[field, :, k]
-        v[4:7] = self.stress[field, :, k]
-        v[_WK] = self.W[field, k] + self.K[field, k]
-        return v
+        v, has = self.table(np.array([node]), field)
+        return v[0] if has[0] else None
 
     def field_crack(self, node: int) -> int:
         """Crack index of field 1 at a flat grid node (-1 none)."""
@@ -510,17 +504,16 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
         raise ValueError(f"crack {bad_crack} runs along a J-contour edge near "
                          f"({xs[bad_edge]:g}, {ys[bad_edge]:g}); keep cracks off grid lines")
     # (edge, t along edge, crack, chord start particle k, u along chord)
+    # (only the first _MAX_HITS are kept; more are counted)
     hits = [(int(h[0]), float(h[1]), int(h[2]), int(h[3]), float(h[4]))
             for h in found[:min(nhit, _MAX_HITS)]]
-    if nhit > _MAX_HITS:
-        hits += [(-1, 0.0, crack_index, -1, 0.0)] * (nhit - _MAX_HITS)   # only counted
     others = [h for h in hits if h[2] != crack_index]
     if others:
         raise ValueError(f"crack {others[0][2]} crosses the J contour of crack "
                          f"{crack_index}; contours crossing other cracks are not supported")
-    if len(hits) != 1:
+    if nhit != 1:
         raise ValueError(f"the J contour (half-size {s} cells) crosses crack {crack_index} "
-                         f"{len(hits)} times; it must cross it exactly once")
+                         f"{nhit} times; it must cross it exactly once")
     e_hit, f_hit, _, k_hit, u_hit = hits[0]
 
     # trapezoid rule on field 0 along every edge but the crossed one

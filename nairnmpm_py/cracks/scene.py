@@ -152,8 +152,8 @@ class CrackScene:
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
             self.law1, self.law2, float(sim.grid.thickness), use_position,
             float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
-            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush, self.pend,
-            self.chords_now, self.cxy_now, self.cnodes_now)
+            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush,
+            self.pend, self.chords_now, self.cxy_now, self.cnodes_now)
         return done, status, who
 
     # ---- zone and traction work -------------------------------------------------------
