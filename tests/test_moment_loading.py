@@ -38,3 +38,8 @@ def test_end_moment_bends_the_cantilever_as_beam_theory_says():
     reaction_x = [v for k, v in rec.rows[-1].items() if k.startswith("load_N_") and
                   k.endswith("_x")][0]
     assert abs(reaction_x) < 0.02 * rate * sim.time
+    # global.csv's moment column: the two end forces are one group (no crack between
+    # them), and their moment is F times the 3.5 mm between the rows
+    moments = [k for k in rec.rows[-1] if k.startswith("moment_Nmm_")]
+    assert len(moments) == 1
+    assert rec.rows[-1][moments[0]] == pytest.approx(moment, rel=0.005)

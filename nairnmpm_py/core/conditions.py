@@ -28,6 +28,7 @@ class ConditionRecord:
     ftime: float = 0.0
     n_members: int = 0
     function: str | None = None   # style 6: expression of t (ms since t0)
+    shape_line: int = 0   # input line of the BCLine/BCPt/LdRect that selected the members
 
 
 @njit(cache=True, inline="always")

@@ -19,6 +19,7 @@ from ..errors import SimulationUnstable
 from .conditions import GRID_VELOCITY, ConditionRecord, Conditions, evaluate_expression
 from .grid import Grid
 from .kernel_build import load_kernels, material_table
+from .load_couples import couple_moment, load_couples
 from .particles import Particles
 from .shape import LINEAR, UGIMP
 
@@ -70,6 +71,7 @@ class Simulation:
         self.time = 0.0
         self.step = 0
         self.kernels = None
+        self.couples = []      # particle-load groups with a moment column (prepare)
         self.rec_force = np.zeros(len(self.conditions.records))
         self.rec_work = np.zeros(len(self.conditions.records))
 
@@ -133,6 +135,9 @@ class Simulation:
                 members = part_ids[part_recs == r]
                 d = rec.direction
                 row[f"disp_mm_{rec.name}"] = float(np.mean(p.pos[d, members] - p.pos0[d, members])) if members.size else 0.0
+        for couple in self.couples:
+            row[f"moment_Nmm_{couple.name}"] = couple_moment(couple, cond.records,
+                                                             self.rec_force, p.pos)
         for q in self.global_quantities:
             sel = slice(None) if q.material < 0 else (p.mat == q.material)
             m = p.mass[sel]
@@ -179,6 +184,7 @@ class Simulation:
         self.leave_max = self.leave_limit if self.leave_limit > 0 else max(1, p.n // 100)
         self.sym_out, self.sym_in, self.sym_dir = self._symmetry_mirrors()
         self.cond_arrays = self.conditions.arrays()
+        self.couples = load_couples(self.conditions, p.pos, self.cracks)
         self.geom = g.geometry_vector()
         self.bounds = g.bounds()
         # any node with mass has a velocity: p/m is accurate even for tiny weights, and

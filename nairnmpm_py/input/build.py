@@ -442,7 +442,8 @@ def _conditions(r: Reader, model: InputModel, grid: Grid, particles: Particles) 
             axis_name = "x" if direction == 0 else "y"
         rec = ConditionRecord(f"bc{cond.line}_{axis_name}", PARTICLE_LOAD, direction,
                               cond.style, 1.0 if cond.style == 6 else cond.value, cond.time,
-                              cond.ftime, function=cond.function)
+                              cond.ftime, function=cond.function,
+                              shape_line=cond.shape_line or 0)
         conds.add_particle_load(rec, members, scale)
     return conds
 
