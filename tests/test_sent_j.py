@@ -17,7 +17,6 @@ the root particle stands for half a segment beyond the last traction-loaded poin
 """
 from __future__ import annotations
 
-import csv
 import math
 import re
 from pathlib import Path

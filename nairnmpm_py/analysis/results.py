@@ -5,7 +5,6 @@ from __future__ import annotations
 import csv
 
 import json
-import warnings
 from pathlib import Path
 
 import h5py

@@ -86,8 +86,7 @@ class NodalFields:
     Arrays cover a window of the grid (``nodal_fields(window=...)``; by default all
     nodes, ghosts included, when local and flat ``Grid`` indices coincide): local
     index = (row - wj0) * wnx + (column - wi0), in ghost-inclusive node rows and
-    columns.  ``local`` maps flat grid indices to it.  Values of a field with no
-    mass are 0.
+    columns.  Values of a field with no mass are 0.
     """
     kind: int
     mass: np.ndarray      # (2, nw) g
@@ -100,35 +99,10 @@ class NodalFields:
     multi: np.ndarray     # (nw,) bool: node sees two different cracks (not supported)
     conflicts: int        # particle-node pairs put in field 0 because they crossed
                           # field 1's crack from the unexpected side (node on a crack)
-    nnx: int = 0          # nodes per grid row (ghosts included)
     wi0: int = 0          # window: first column and row, columns per row
     wj0: int = 0
     wnx: int = 0
 
-    def local(self, node):
-        """Window index of flat grid node index(es) ``node`` (must lie in the window)."""
-        node = np.asarray(node)
-        return (node // self.nnx - self.wj0) * self.wnx + (node % self.nnx - self.wi0)
-
-    def values(self, node: int, field: int) -> np.ndarray | None:
-        """The value vector at (flat grid node, field) for the contour, or None if
-        empty."""
-        v, has = self.table(np.array([node]), field)
-        return v[0] if has[0] else None
-
-    def field_crack(self, node: int) -> int:
-        """Crack index of field 1 at a flat grid node (-1 none)."""
-        return int(self.crack[int(self.local(node))])
-
-    def table(self, nodes: np.ndarray, field: int) -> tuple[np.ndarray, np.ndarray]:
-        """(value vectors (len(nodes), 8) for the contour, has-mass mask) at flat grid
-        nodes ``nodes`` for one field."""
-        k = self.local(nodes)
-        v = np.empty((len(k), _NV))
-        v[:, 0:4] = self.grad[field][:, k].T
-        v[:, 4:7] = self.stress[field][:, k].T
-        v[:, _WK] = self.W[field, k] + self.K[field, k]
-        return v, self.mass[field, k] > 0.0
 
 @njit(cache=True)
 def _extrapolate(pos, vel, mass, vol0, lp, F, stress, w, geom, kind,
@@ -315,7 +289,7 @@ def nodal_fields(grid: Grid, particles, cracks: CrackSet | None, kind: int,
     return NodalFields(kind=int(kind), mass=m, grad=g * inv[:, None, :],
                        stress=s * inv[:, None, :], W=en * inv, K=ke * inv,
                        crack=ncrack, side=nside, multi=multi, conflicts=int(counts[0]),
-                       nnx=grid.nodes_x, wi0=wi0, wj0=wj0, wnx=wnx)
+                       wi0=wi0, wj0=wj0, wnx=wnx)
 
 
 @dataclass
@@ -358,46 +332,6 @@ def crack_tip(cracks: CrackSet, crack_index: int, tip_end: str):
     if ln == 0.0:
         raise ValueError(f"crack {crack_index}: tip and adjacent crack particle coincide")
     return tip, adj, d / ln
-
-
-def _contour_path(ic: int, jc: int, s: int) -> list[tuple[int, int]]:
-    """Nodes of the square of half-size s around (ic, jc), CCW, from the middle of the
-    right side back to it (first == last)."""
-    path = [(ic + s, j) for j in range(jc, jc + s)]
-    path += [(i, jc + s) for i in range(ic + s, ic - s, -1)]
-    path += [(ic - s, j) for j in range(jc + s, jc - s, -1)]
-    path += [(i, jc - s) for i in range(ic - s, ic + s)]
-    path += [(ic + s, j) for j in range(jc - s, jc + 1)]
-    return path
-
-
-def _integrand(v: np.ndarray | None, nx: float, ny: float) -> np.ndarray:
-    """(f_x, f_y) = (W+K) n - (sigma.n) . du/dx_k; zero for an empty field."""
-    if v is None:
-        return np.zeros(2)
-    tx = v[_SXX] * nx + v[_SXY] * ny
-    ty = v[_SXY] * nx + v[_SYY] * ny
-    fx = v[_WK] * nx - (tx * v[_GXX] + ty * v[_GYX])
-    fy = v[_WK] * ny - (tx * v[_GXY] + ty * v[_GYY])
-    return np.array([fx, fy])
-
-
-def _integrands(V: np.ndarray, has: np.ndarray, nx: np.ndarray, ny: np.ndarray) -> np.ndarray:
-    """``_integrand`` for rows of value vectors (zero where ``has`` is False)."""
-    tx = V[:, _SXX] * nx + V[:, _SXY] * ny
-    ty = V[:, _SXY] * nx + V[:, _SYY] * ny
-    fx = V[:, _WK] * nx - (tx * V[:, _GXX] + ty * V[:, _GYX])
-    fy = V[:, _WK] * ny - (tx * V[:, _GXY] + ty * V[:, _GYY])
-    return np.where(has[:, None], np.column_stack([fx, fy]), 0.0)
-
-
-def _blend(a: np.ndarray | None, b: np.ndarray | None, f: float) -> np.ndarray | None:
-    """(1-f) a + f b, using the available one alone if the other field is empty."""
-    if a is None:
-        return b
-    if b is None:
-        return a
-    return (1.0 - f) * a + f * b
 
 
 _MAX_HITS = 16
@@ -459,6 +393,155 @@ def _contour_hits(xs, ys, px, py, first, count, tol, found):
     return nhit, -1, -1
 
 
+@njit(cache=True, inline="always")
+def _node_values(grad, stress, W, K, fld, k, out):
+    """The contour's value vector of field ``fld`` at window node k into ``out``."""
+    out[_GXX] = grad[fld, 0, k]
+    out[_GXY] = grad[fld, 1, k]
+    out[_GYX] = grad[fld, 2, k]
+    out[_GYY] = grad[fld, 3, k]
+    out[_SXX] = stress[fld, 0, k]
+    out[_SYY] = stress[fld, 1, k]
+    out[_SXY] = stress[fld, 2, k]
+    out[_WK] = W[fld, k] + K[fld, k]
+
+
+@njit(cache=True, inline="always")
+def _flux(v, nx, ny):
+    """(f_x, f_y) = (W+K) n - (sigma.n) . du/dx_k for a value vector."""
+    tx = v[_SXX] * nx + v[_SXY] * ny
+    ty = v[_SXY] * nx + v[_SYY] * ny
+    return (v[_WK] * nx - (tx * v[_GXX] + ty * v[_GYX]),
+            v[_WK] * ny - (tx * v[_GXY] + ty * v[_GYY]))
+
+
+@njit(cache=True, inline="always")
+def _blend_into(a, has_a, b, has_b, f, out):
+    """out = (1-f) a + f b, or the available one alone; False if neither is."""
+    if has_a and has_b:
+        for q in range(_NV):
+            out[q] = (1.0 - f) * a[q] + f * b[q]
+    elif has_a:
+        out[:] = a
+    elif has_b:
+        out[:] = b
+    return has_a or has_b
+
+
+# _contour_j status codes (j_integral turns them into messages)
+_J_OK, _J_MULTI, _J_ALONG, _J_OTHER, _J_COUNT, _J_EMPTY, _J_WINDOW = 0, 1, 2, 3, 4, 5, 6
+
+
+@njit(cache=True)
+def _contour_j(mass, grad, stress, W, K, fcrack, multi, wi0, wj0, wnx, wny, ic, jc, s,
+               x0, y0, hx, hy, px, py, first, count, crack_index, found):
+    """J over the square of half-size s around real-grid node (ic, jc), walked CCW
+    from the middle of its right side (module docstring, step 2).  Returns (status,
+    Jx, Jy, crossings, bad edge, bad crack, x, y of the bad edge's start); ``found``
+    row 0 is the crossing (edge, t along it, crack, chord start, u along the chord)."""
+    npath = 8 * s + 1
+    ii = np.empty(npath, dtype=np.int64)
+    jj = np.empty(npath, dtype=np.int64)
+    q = 0
+    for j in range(jc, jc + s):
+        ii[q] = ic + s
+        jj[q] = j
+        q += 1
+    for i in range(ic + s, ic - s, -1):
+        ii[q] = i
+        jj[q] = jc + s
+        q += 1
+    for j in range(jc + s, jc - s, -1):
+        ii[q] = ic - s
+        jj[q] = j
+        q += 1
+    for i in range(ic - s, ic + s):
+        ii[q] = i
+        jj[q] = jc - s
+        q += 1
+    for j in range(jc - s, jc + 1):
+        ii[q] = ic + s
+        jj[q] = j
+        q += 1
+    xs = np.empty(npath)
+    ys = np.empty(npath)
+    loc = np.empty(npath, dtype=np.int64)
+    for q in range(npath):
+        li = ii[q] + GHOST - wi0
+        lj = jj[q] + GHOST - wj0
+        if li < 0 or li >= wnx or lj < 0 or lj >= wny:
+            return _J_WINDOW, 0.0, 0.0, 0, -1, -1, 0.0, 0.0
+        loc[q] = lj * wnx + li
+        xs[q] = x0 + ii[q] * hx
+        ys[q] = y0 + jj[q] * hy
+    for q in range(npath):
+        if multi[loc[q]]:
+            return _J_MULTI, 0.0, 0.0, 0, -1, -1, 0.0, 0.0
+    nhit, bad_edge, bad_crack = _contour_hits(xs, ys, px, py, first, count,
+                                              1e-12 * (hx + hy), found)
+    if bad_edge >= 0:
+        return _J_ALONG, 0.0, 0.0, nhit, bad_edge, bad_crack, xs[bad_edge], ys[bad_edge]
+    for h in range(min(nhit, found.shape[0])):
+        if int(found[h, 2]) != crack_index:
+            return _J_OTHER, 0.0, 0.0, nhit, -1, int(found[h, 2]), 0.0, 0.0
+    if nhit != 1:
+        return _J_COUNT, 0.0, 0.0, nhit, -1, -1, 0.0, 0.0
+    empty = True
+    for q in range(npath):
+        if mass[0, loc[q]] > 0.0:
+            empty = False
+    if empty:
+        return _J_EMPTY, 0.0, 0.0, nhit, -1, -1, 0.0, 0.0
+    e_hit = int(found[0, 0])
+    f = found[0, 1]
+    va = np.zeros(_NV)
+    vb = np.zeros(_NV)
+    fa = np.zeros(_NV)
+    fb = np.zeros(_NV)
+    mid = np.zeros(_NV)
+    jx = 0.0
+    jy = 0.0
+    for e in range(npath - 1):
+        dxe = xs[e + 1] - xs[e]
+        dye = ys[e + 1] - ys[e]
+        ds = math.sqrt(dxe * dxe + dye * dye)
+        nx = dye / ds                   # outward for a CCW walk
+        ny = -dxe / ds
+        a = loc[e]
+        b = loc[e + 1]
+        has_a = mass[0, a] > 0.0
+        has_b = mass[0, b] > 0.0
+        ax = ay = bx = by = 0.0
+        if has_a:
+            _node_values(grad, stress, W, K, 0, a, va)
+            ax, ay = _flux(va, nx, ny)
+        if has_b:
+            _node_values(grad, stress, W, K, 0, b, vb)
+            bx, by = _flux(vb, nx, ny)
+        if e != e_hit:                  # trapezoid rule on field 0
+            jx += 0.5 * (ax + bx) * ds
+            jy += 0.5 * (ay + by) * ds
+            continue
+        # the crossed edge: each side of the crossing with that side's fields
+        has_fa = fcrack[a] == crack_index and mass[1, a] > 0.0
+        has_fb = fcrack[b] == crack_index and mass[1, b] > 0.0
+        if has_fa:
+            _node_values(grad, stress, W, K, 1, a, fa)
+        if has_fb:
+            _node_values(grad, stress, W, K, 1, b, fb)
+        mx = my = 0.0
+        if _blend_into(va, has_a, fb, has_fb, f, mid):      # node a's side, at the crossing
+            mx, my = _flux(mid, nx, ny)
+        jx += 0.5 * (ax + mx) * (f * ds)
+        jy += 0.5 * (ay + my) * (f * ds)
+        mx = my = 0.0
+        if _blend_into(fa, has_fa, vb, has_b, f, mid):      # node b's side, at the crossing
+            mx, my = _flux(mid, nx, ny)
+        jx += 0.5 * (mx + bx) * ((1.0 - f) * ds)
+        jy += 0.5 * (my + by) * ((1.0 - f) * ds)
+    return _J_OK, jx, jy, nhit, -1, -1, 0.0, 0.0
+
+
 def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: int,
                tip_end: str = "end", size_cells: int = 2) -> JResult:
     """J integral of one crack tip on a square grid contour (JINTEGRAL.md sections 2-4).
@@ -480,69 +563,32 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
     if ic - s < 0 or ic + s > grid.nx or jc - s < 0 or jc + s > grid.ny:
         raise ValueError(f"J contour of half-size {s} cells around node ({ic}, {jc}) "
                          f"leaves the grid (0..{grid.nx}, 0..{grid.ny})")
-    path = _contour_path(ic, jc, s)
-    ij = np.array(path)
-    nodes = grid.node_index(ij[:, 0], ij[:, 1])
-    if fields.multi[fields.local(nodes)].any():
-        raise ValueError("the J contour passes a node that sees two cracks")
-    xs = grid.xmin + ij[:, 0] * hx
-    ys = grid.ymin + ij[:, 1] * hy
-
-    # crossings of the contour edges with every crack's chords.  Sign tests as in
-    # the particle-node crossing test: a crack particle exactly on an edge's line
-    # is counted by one of its two chords only (its side value is the same float
-    # for both, and 0 counts as positive), and a node exactly on a chord's line by
-    # one edge only ((0, 1] along the walk), so nothing is counted twice or lost to
-    # rounding.
     P = cracks.plane
-    first = np.ascontiguousarray(cracks.first, dtype=np.int64)
-    count = np.ascontiguousarray(cracks.count, dtype=np.int64)
     found = np.zeros((_MAX_HITS, 5))
-    nhit, bad_edge, bad_crack = _contour_hits(xs, ys, P[0], P[1], first, count,
-                                              1e-12 * (hx + hy), found)
-    if bad_edge >= 0:
+    wny = fields.mass.shape[1] // fields.wnx
+    status, Jx, Jy, nhit, bad_edge, bad_crack, bx, by = _contour_j(
+        fields.mass, fields.grad, fields.stress, fields.W, fields.K, fields.crack,
+        fields.multi, fields.wi0, fields.wj0, fields.wnx, wny, ic, jc, s, grid.xmin,
+        grid.ymin, hx, hy, np.ascontiguousarray(P[0]), np.ascontiguousarray(P[1]),
+        np.ascontiguousarray(cracks.first, dtype=np.int64),
+        np.ascontiguousarray(cracks.count, dtype=np.int64), crack_index, found)
+    if status == _J_WINDOW:
+        raise ValueError(f"J contour of half-size {s} cells around node ({ic}, {jc}) "
+                         "is outside the window of nodal fields it was given")
+    if status == _J_MULTI:
+        raise ValueError("the J contour passes a node that sees two cracks")
+    if status == _J_ALONG:
         raise ValueError(f"crack {bad_crack} runs along a J-contour edge near "
-                         f"({xs[bad_edge]:g}, {ys[bad_edge]:g}); keep cracks off grid lines")
-    # (edge, t along edge, crack, chord start particle k, u along chord)
-    # (only the first _MAX_HITS are kept; more are counted)
-    hits = [(int(h[0]), float(h[1]), int(h[2]), int(h[3]), float(h[4]))
-            for h in found[:min(nhit, _MAX_HITS)]]
-    others = [h for h in hits if h[2] != crack_index]
-    if others:
-        raise ValueError(f"crack {others[0][2]} crosses the J contour of crack "
+                         f"({bx:g}, {by:g}); keep cracks off grid lines")
+    if status == _J_OTHER:
+        raise ValueError(f"crack {bad_crack} crosses the J contour of crack "
                          f"{crack_index}; contours crossing other cracks are not supported")
-    if nhit != 1:
+    if status == _J_COUNT:
         raise ValueError(f"the J contour (half-size {s} cells) crosses crack {crack_index} "
                          f"{nhit} times; it must cross it exactly once")
-    e_hit, f_hit, _, k_hit, u_hit = hits[0]
-
-    # trapezoid rule on field 0 along every edge but the crossed one
-    V, has = fields.table(nodes, 0)
-    if not has.any():
+    if status == _J_EMPTY:
         raise ValueError("no node of the J contour has particles")
-    dxe, dye = np.diff(xs), np.diff(ys)
-    ds = np.hypot(dxe, dye)
-    nx, ny = dye / ds, -dxe / ds                 # outward for a CCW walk
-    f_from = _integrands(V[:-1], has[:-1], nx, ny)
-    f_to = _integrands(V[1:], has[1:], nx, ny)
-    edge = 0.5 * (f_from + f_to) * ds[:, None]
-    edge[e_hit] = 0.0
-    J = edge.sum(axis=0)
-    # the crossed edge: each side of the crossing with that side's fields
-    e = e_hit
-    n1, n2 = int(nodes[e]), int(nodes[e + 1])
-    v1 = V[e] if has[e] else None
-    v2 = V[e + 1] if has[e + 1] else None
-    f = f_hit
-    a1 = fields.values(n1, 1) if fields.field_crack(n1) == crack_index else None
-    a2 = fields.values(n2, 1) if fields.field_crack(n2) == crack_index else None
-    end_v = _blend(v1, a2, f)        # node1's side, at the crossing
-    start_v = _blend(a1, v2, f)      # node2's side, at the crossing
-    nxe, nye = nx[e], ny[e]
-    J += 0.5 * (_integrand(v1, nxe, nye) + _integrand(end_v, nxe, nye)) * (f * ds[e])
-    J += 0.5 * (_integrand(start_v, nxe, nye) + _integrand(v2, nxe, nye)) * ((1.0 - f) * ds[e])
-
-    Jx, Jy = float(J[0]), float(J[1])
+    k_hit, u_hit = int(found[0, 3]), float(found[0, 4])
     J1 = Jx * d[0] + Jy * d[1]
     J2 = -Jx * d[1] + Jy * d[0]
     cross = P[:, k_hit] + u_hit * (P[:, k_hit + 1] - P[:, k_hit])
@@ -551,8 +597,8 @@ def j_integral(grid: Grid, fields: NodalFields, cracks: CrackSet, crack_index: i
     else:
         cp, cb, frac = k_hit, k_hit + 1, u_hit
     corners = np.array([(ic - s, jc - s), (ic + s, jc - s), (ic + s, jc + s), (ic - s, jc + s)])
-    return JResult(J1=float(J1), J2=float(J2), Jx=Jx, Jy=Jy, direction=d.copy(), tip=tip,
-                   crossing=np.asarray(cross, dtype=float), crossing_particle=int(cp),
+    return JResult(J1=float(J1), J2=float(J2), Jx=float(Jx), Jy=float(Jy), direction=d.copy(),
+                   tip=tip, crossing=np.asarray(cross, dtype=float), crossing_particle=int(cp),
                    crossing_beyond=int(cb), crossing_fraction=float(frac), centre=(ic, jc),
                    size_cells=s, corners=corners,
                    corner_nodes=grid.node_index(corners[:, 0], corners[:, 1]))

@@ -171,17 +171,16 @@ class CrackScene:
 
     def zone(self, tip: Tip) -> tuple[list[int], int]:
         """(crack particles of the traction zone from the tip side, root particle);
-        no zone gives ([], tip particle)."""
+        no zone gives ([], tip particle).  The zone is the unbroken run of
+        traction-carrying particles that starts at the tip or its neighbour."""
         walk = self._walk(tip)
-        zone = []
-        for k in walk:
-            if self.state[k] == ACTIVE:
-                zone.append(int(k))
-            elif zone:
-                break
-            elif k != walk[0] and k != walk[1]:
-                break   # the zone must start at the tip or its neighbour
-        return zone, (zone[-1] if zone else int(walk[0]))
+        active = self.state[walk] == ACTIVE
+        start = 0 if active[0] else (1 if walk.size > 1 and active[1] else -1)
+        if start < 0:
+            return [], int(walk[0])
+        ends = np.flatnonzero(~active[start:])
+        run = walk[start:start + (int(ends[0]) if ends.size else walk.size - start)]
+        return run.tolist(), int(run[-1])
 
     def traction_work(self, k: int) -> float:
         """W_B (J/m^2) done by the tractions of crack particle k so far."""
@@ -335,8 +334,8 @@ class CrackScene:
         return int(np.flatnonzero(self.pid == pid)[0])
 
     def _beyond_root(self, tip: Tip, k: int, zone: list[int]) -> bool:
-        walk = list(self._walk(tip))
-        return walk.index(k) > walk.index(zone[-1])
+        """Is crack particle k farther from the tip than the root (zone[-1])?"""
+        return k < zone[-1] if tip.end == "end" else k > zone[-1]
 
     # ---- propagation ------------------------------------------------------------------
     def propagate(self, sim) -> list[dict]:
