@@ -7,7 +7,7 @@ the load rate) and keeps J_tip near it while the bridging zone forms behind it; 
 energy released R (Eq 15) rises with the opening at the notch root as Eq 22 says and
 levels off at J_tip,c + J_B once the root has broken (the notch root then advances
 and the zone keeps its length).  Measured at these settings: J_ff / beam theory
-0.962-1.005 in 1-ms means over 4-10 ms; growth from 10.02 ms; R - Eq 22 RMS 0.1 % of
+0.972-0.999 in 1-ms means over 4-10 ms; growth from 10.02 ms; R - Eq 22 RMS 0.1 % of
 J_tip,c; R on the plateau 196-200 J/m^2 while the crack grows its first 40 mm.
 
 With 2 mm cells (arms 3 cells thick) J_ff comes out 25 % below beam theory, so the
@@ -15,7 +15,6 @@ coarse version of this test is the paper's resolution halved, not quartered.
 """
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
@@ -36,7 +35,7 @@ class JSampler:
     applied loads) at every global archive before the crack grows."""
 
     def __init__(self):
-        self.t, self.J, self.M = [], [], []
+        self.t, self.J, self.M, self.arms = [], [], [], []
 
     def begin(self, sim):
         pass
@@ -50,6 +49,7 @@ class JSampler:
         self.t.append(sim.time)
         self.J.append(j)
         self.M.append(math.hypot(row[loads[0]], row[loads[1]]) * LEVER)
+        self.arms.append([row[k] for k in row if k.startswith("moment_Nmm_")])
 
     def on_archive(self, sim):
         pass
@@ -58,9 +58,10 @@ class JSampler:
         pass
 J_TIP_C, J_B, SIGMA_C = 100.0, 100.0, 0.5
 DELTA_C = 16 * J_B / (9 * SIGMA_C) / 1000.0
-# J_ff against beam theory at 1 mm cells: the issue asks 2 %; the 1-ms means swing
-# by about +-2 % about a 1.5 % low mean (the arms ring at a 2 ms period), worst 3.8 %
-TOL_J_1MM = 0.04
+# J_ff against beam theory at 1 mm cells: the issue asks 2 %; here the 1-ms means are
+# 0.972-0.999 (a mean 1.8 % low with 6-cell arms; 0.4 % low at the paper's 0.5 mm
+# cells, where every window from 3 to 10 ms is within 1.4 %), so 3 %
+TOL_J_1MM = 0.03
 
 
 @pytest.fixture(scope="module")
@@ -94,6 +95,18 @@ def test_J_ff_before_growth_follows_beam_theory(dcb):
     # over the whole linear ramp the swing averages out: the issue's 2 % holds there
     ramp = (t > 4.0) & (t <= 10.0)
     assert J[ramp].mean() / theory[ramp].mean() == pytest.approx(1.0, abs=0.02)
+
+
+def test_global_csv_reports_each_arms_moment(dcb):
+    """The crack separates the two loaded rows of each arm from the other arm's, so
+    global.csv has one moment column per arm: equal and opposite, each the row force
+    times the lever between the rows."""
+    s = dcb.j_samples
+    arms, M = np.array(s.arms), np.array(s.M)
+    assert arms.shape[1] == 2
+    late = M > 0.1 * M.max()
+    np.testing.assert_allclose(arms[late, 0], -arms[late, 1], rtol=1e-3)
+    np.testing.assert_allclose(np.abs(arms[late, 0]), M[late], rtol=0.01)
 
 
 def test_growth_starts_at_J_tip_c_and_tracks_it(dcb):
