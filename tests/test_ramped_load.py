@@ -125,3 +125,54 @@ def test_plane_strain_is_stiffer_by_one_minus_nu_squared(results):
     ratio = results[10]["end_disp"] / results[11]["end_disp"]
     assert ratio == pytest.approx(1 - NU ** 2, rel=0.02)
     assert ratio < 0.95   # clearly different, not equal within noise
+
+
+TRACTION = """    <LdRect xmin="99" xmax="{L}" ymin="0" ymax="{W}">
+      <TractionBC dir="1" face="2" style="2" stress="{rate}" time="0"/>
+      <TractionBC dir="1" face="2" style="2" stress="-{rate}" time="{t_ramp}"/>
+    </LdRect>"""
+
+
+CRACK = """  <CrackList>
+    <Line xmin="40" ymin="5" xmax="60" ymax="5" resolution="20"/>
+  </CrackList>
+"""
+
+
+@pytest.mark.parametrize("crack", [False, True], ids=["no crack", "crack along the bar"])
+def test_traction_on_the_end_face_settles_at_the_same_stress(tmp_path, crack):
+    """The same bar pulled by a TractionBC (sigma = 1 MPa on the right face of the last
+    particle column) instead of the net LoadBC: the traction acts on the face, half at
+    each of its corners with linear grid weights (as NairnMPM applies it), adds up to
+    sigma times the face area, and the bar settles at sigma_xx = sigma.  With a crack
+    along the bar (parallel to the load, so it changes nothing) the crack kernels
+    apply the traction the same way."""
+    start, end = XML.index("    <LdRect"), XML.index("  </ParticleBCs>")
+    body = XML[:start] + TRACTION + "\n" + XML[end:]
+    if crack:
+        body = body.replace("  <Material ", CRACK + "  <Material ", 1)
+    text = body.format(
+        analysis=11, t_end=T_END, gx=L + 4, gy=W + 4, thick=THICK, L=L, W=W, E=E, nu=NU,
+        rate=SIGMA / T_RAMP, t_ramp=T_RAMP)
+    sim = build(tmp_path, text, "traction.xml")
+    rec = Recorder()
+    assert sim.run(outputs=[rec])["exit_status"] == "done"
+    last = rec.rows[-1]
+    applied = sum(v for k, v in last.items()
+                  if k.startswith("load_N_") and k != f"load_N_bc{line_of(text, '<DisBC')}_x")
+    assert applied == pytest.approx(F, rel=1e-3)
+    s = sim.particles.stress
+    x0 = sim.particles.pos0[0]
+    mid = (x0 > 0.2 * L) & (x0 < 0.8 * L)
+    err = np.abs(s[0, mid] / SIGMA - 1)
+    if crack:
+        # the crack's tips (x = 40, 60) disturb sigma_xx by up to 6 % within about
+        # 15 mm with either kind of load (2 mm cells), so look farther away
+        mid &= np.abs(x0 - 50.0) > 20.0
+        err = np.abs(s[0, mid] / SIGMA - 1)
+    print(f"traction: sigma_xx mean {s[0, mid].mean():.5f} MPa, max error {100 * err.max():.3f}%")
+    assert err.max() < 0.01
+    assert last[f"load_N_bc{line_of(text, '<DisBC')}_x"] == pytest.approx(-F, rel=0.01)
+    # the loaded particles' own stress is the traction too (the face carries it)
+    end = x0 > 99.0
+    assert s[0, end].mean() == pytest.approx(SIGMA, rel=0.02)

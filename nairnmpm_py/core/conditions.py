@@ -85,6 +85,7 @@ class Conditions:
     part_ids: list = field(default_factory=list)
     part_dirs: list = field(default_factory=list)
     part_scales: list = field(default_factory=list)
+    part_faces: list = field(default_factory=list)   # 0 = the particle, 1-4 its face
     part_recs: list = field(default_factory=list)
 
     def add_grid_velocity(self, record: ConditionRecord, nodes: np.ndarray) -> None:
@@ -96,13 +97,18 @@ class Conditions:
         self.grid_recs += [r] * len(nodes)
 
     def add_particle_load(self, record: ConditionRecord, particles: np.ndarray,
-                          scales: np.ndarray) -> None:
+                          scales: np.ndarray, face: int = 0) -> None:
+        """``face`` 0: the load goes to the nodes with the particle's own weights
+        (LoadBC); 1-4 (bottom, right, top, left): it acts on that face of the particle
+        (TractionBC), half at each of the face's two corners, with linear grid weights
+        there, as NairnMPM applies tractions."""
         r = len(self.records)
         record.n_members = len(particles)
         self.records.append(record)
         self.part_ids += [int(p) for p in particles]
         self.part_dirs += [record.direction] * len(particles)
         self.part_scales += [float(s) for s in scales]
+        self.part_faces += [int(face)] * len(particles)
         self.part_recs += [r] * len(particles)
 
     def renumber_particles(self, new_index_of_old: np.ndarray) -> None:
@@ -117,7 +123,8 @@ class Conditions:
             gbc_node=ints(self.grid_nodes), gbc_dir=ints(self.grid_dirs),
             gbc_rec=ints(self.grid_recs),
             pbc_part=ints(self.part_ids), pbc_dir=ints(self.part_dirs),
-            pbc_scale=np.array(self.part_scales, dtype=float), pbc_rec=ints(self.part_recs),
+            pbc_scale=np.array(self.part_scales, dtype=float), pbc_face=ints(self.part_faces),
+            pbc_rec=ints(self.part_recs),
             rec_style=ints([r.style for r in recs]),
             rec_value=np.array([r.value for r in recs], dtype=float),
             rec_t0=np.array([r.t0 for r in recs], dtype=float),

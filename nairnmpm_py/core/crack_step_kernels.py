@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, _stress_update, _store_weights  # KERNEL-BASE
+from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, face_corner, corner_cell, _stress_update, _store_weights  # KERNEL-BASE
 from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
 from nairnmpm_py.cracks.crossing import segment_crossing_side
 from nairnmpm_py.cracks.chords import _chord, _chord_cells
@@ -455,7 +455,7 @@ def velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec
 
 # ---- forces ------------------------------------------------------------------------------
 @njit(cache=True, error_model="numpy")
-def scatter_loads(pos, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+def scatter_loads(pos, lp, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
                   rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
     nnx = int(geom[4])
     for q in range(pbc_part.size):
@@ -466,6 +466,24 @@ def scatter_loads(pos, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_sc
         pload[q] = f
         rec_force[r] += f
         row_c = GFX + pbc_dir[q]
+        if pbc_face[q] > 0:
+            # a traction: half the force at each corner of the face, on nodes with mass,
+            # in the field the particle uses at that node (field 0 outside its nodes)
+            for corner in range(2):
+                cx, cy = face_corner(pos, lp, F, geom, p, pbc_face[q], corner)
+                i, j, fx, fy = corner_cell(cx, cy, geom, g.shape[2] // nnx)
+                for b in range(2):
+                    wy = fy if b == 1 else 1.0 - fy
+                    for a in range(2):
+                        k = (j + b) * nnx + i + a
+                        pa = i + a - wij[p, 0]
+                        pb = j + b - wij[p, 1]
+                        fld = 0
+                        if cut[p] and 0 <= pa < NA and 0 <= pb < NA:
+                            fld = vfld[p, pb * NA + pa]
+                        if g[fld, GM, k] > 0.0:
+                            g[fld, row_c, k] += 0.5 * wy * (fx if a == 1 else 1.0 - fx) * f
+            continue
         w = wc[p]
         for b in range(NA):
             row = (wij[p, 1] + b) * nnx + wij[p, 0]
@@ -1131,7 +1149,7 @@ def crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, nnx, ns
 def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp, mat_params,
             geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax, left, leave_limit,
-            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
             rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
             sym_out, sym_in, sym_dir, bad, nch,
             cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate, chist,
@@ -1180,7 +1198,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                           pend, plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress,
                           hist, w, pdamp, mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp,
                           damping, vmax, left, leave_limit, gbc_node, gbc_dir, gbc_rec,
-                          pbc_part, pbc_dir, pbc_scale, pbc_rec, rec_style, rec_value, rec_t0,
+                          pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec, rec_style, rec_value, rec_t0,
                           rec_ftime, rec_force, rec_work, sym_out, sym_in, sym_dir, bad, nch,
                           cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw, cstate,
                           chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut,
@@ -1202,7 +1220,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
                       plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w,
                       pdamp, mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax,
                       left, leave_limit, gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir,
-                      pbc_scale, pbc_rec, rec_style, rec_value, rec_t0, rec_ftime, rec_force,
+                      pbc_scale, pbc_face, pbc_rec, rec_style, rec_value, rec_t0, rec_ftime, rec_force,
                       rec_work, sym_out, sym_in, sym_dir, bad, nch, cp, ca, cb, cfirst, clast,
                       cext0, cext1, ccrack, cfixed, claw, cstate, chist, law1, law2, thickness,
                       use_position, cutoff_cells, vfld, cut, wij, wc, nslot, cbox, counts,
@@ -1213,7 +1231,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
 def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush, pend,
                plane_stress, pos, pos0, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp,
                mat_params, geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, vmax, left,
-               leave_limit, gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+               leave_limit, gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
                rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work, sym_out, sym_in,
                sym_dir, bad, nch, cp, ca, cb, cfirst, clast, cext0, cext1, ccrack, cfixed, claw,
                cstate, chist, law1, law2, thickness, use_position, cutoff_cells, vfld, cut, wij,
@@ -1230,7 +1248,7 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
         rec_force[:] = 0.0
         g[:, GFX] = 0.0
         g[:, GFY] = 0.0
-        scatter_loads(pos, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+        scatter_loads(pos, lp, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
                       rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]

@@ -263,7 +263,7 @@ class Simulation:
                     self.g, self.gbuf, self.gv, self.ga, self.gvn, self.gtmp, self.damping,
                     self.mass_tol, self.vmax, self.left, self.leave_max,
                     c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-                    c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
+                    c["pbc_scale"], c["pbc_face"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
                     c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
                     self.sym_dir, self.bad, self.nch)
         finally:

@@ -98,8 +98,38 @@ def particle_rotation(F, p):
     return math.atan2(F[2, p] - F[1, p], F[0, p] + F[3, p])
 
 
+@njit(cache=True, inline="always")
+def face_corner(pos, lp, F, geom, p, face, corner):
+    """Corner 0 or 1 of face ``face`` (1 bottom, 2 right, 3 top, 4 left) of particle p,
+    its half-widths turned and stretched by F (NairnMPM loads the deformed face)."""
+    hx = lp[0, p] * geom[2]
+    hy = lp[1, p] * geom[3]
+    s = 1.0 if corner == 1 else -1.0
+    if face == 1:
+        ox, oy = s * hx, -hy
+    elif face == 2:
+        ox, oy = hx, s * hy
+    elif face == 3:
+        ox, oy = s * hx, hy
+    else:
+        ox, oy = -hx, s * hy
+    return (pos[0, p] + F[0, p] * ox + F[1, p] * oy, pos[1, p] + F[2, p] * ox + F[3, p] * oy)
+
+
+@njit(cache=True, inline="always")
+def corner_cell(x, y, geom, nny):
+    """(column, row, fx, fy): the cell holding (x, y) (kept inside the grid of nny node
+    rows) and the fractions across it, for linear weights at a face corner."""
+    nnx = int(geom[4])
+    xi = (x - geom[0]) / geom[2]
+    eta = (y - geom[1]) / geom[3]
+    i = min(max(int(math.floor(xi)), 0), nnx - 2)
+    j = min(max(int(math.floor(eta)), 0), nny - 2)
+    return i, j, min(max(xi - i, 0.0), 1.0), min(max(eta - j, 0.0), 1.0)
+
+
 @njit(cache=True, error_model="numpy")
-def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
                    rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
     """Particle loads (N) at time t onto the grid; pload keeps them for the work."""
     nnx = int(geom[4])
@@ -112,6 +142,18 @@ def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
         pload[q] = f
         rec_force[r] += f
         row_c = GFX + pbc_dir[q]
+        if pbc_face[q] > 0:
+            # a traction: half the force at each corner of the face, on nodes with mass
+            for corner in range(2):
+                cx, cy = face_corner(pos, lp, F, geom, p, pbc_face[q], corner)
+                i, j, fx, fy = corner_cell(cx, cy, geom, g.shape[1] // nnx)
+                for b in range(2):
+                    wy = fy if b == 1 else 1.0 - fy
+                    for a in range(2):
+                        k = (j + b) * nnx + i + a
+                        if g[GM, k] > 0.0:
+                            g[row_c, k] += 0.5 * wy * (fx if a == 1 else 1.0 - fx) * f
+            continue
         xi = (pos[0, p] - geom[0]) / geom[2]
         eta = (pos[1, p] - geom[1]) / geom[3]
         i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, KIND, lp[0, p])
@@ -529,7 +571,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
             pos, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp, mat_params,
             geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, mass_tol, vmax, left,
             leave_limit,
-            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
             rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
             sym_out, sym_in, sym_dir, bad, nch):
     """Run up to ``nsteps`` steps from time ``t`` (ms).
@@ -568,7 +610,7 @@ def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
         rec_force[:] = 0.0
         g[GFX] = 0.0
         g[GFY] = 0.0
-        _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_rec,
+        _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
                        rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
         for q in range(pbc_part.size):
             pos_before[q] = pos[pbc_dir[q], pbc_part[q]]

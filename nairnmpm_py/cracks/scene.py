@@ -146,7 +146,7 @@ class CrackScene:
             p.pdamp, sim.mat_params, sim.geom, sim.bounds, self.g, self.gbuf, self.gv,
             self.ga, self.gvn, sim.gtmp, sim.damping, sim.vmax, sim.left, sim.leave_max,
             c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-            c["pbc_scale"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
+            c["pbc_scale"], c["pbc_face"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
             c["rec_ftime"], sim.rec_force, sim.rec_work, sim.sym_out, sim.sym_in, sim.sym_dir,
             sim.bad, sim.nch, cs.plane, cs.above, cs.below, self.cfirst, self.clast,
             self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,

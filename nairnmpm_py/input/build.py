@@ -444,7 +444,8 @@ def _conditions(r: Reader, model: InputModel, grid: Grid, particles: Particles) 
                               cond.style, 1.0 if cond.style == 6 else cond.value, cond.time,
                               cond.ftime, function=cond.function,
                               shape_line=cond.shape_line or 0)
-        conds.add_particle_load(rec, members, scale)
+        conds.add_particle_load(rec, members, scale,
+                                face=cond.face if cond.element == "TractionBC" else 0)
     return conds
 
 
