@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, face_corner, corner_cell, _stress_update, _store_weights  # KERNEL-BASE
+from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, face_node, _stress_update, _store_weights  # KERNEL-BASE
 from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
 from nairnmpm_py.cracks.crossing import segment_crossing_side
 from nairnmpm_py.cracks.chords import _chord, _chord_cells
@@ -467,22 +467,17 @@ def scatter_loads(pos, lp, F, geom, g, wij, wc, vfld, cut, pbc_part, pbc_dir, pb
         rec_force[r] += f
         row_c = GFX + pbc_dir[q]
         if pbc_face[q] > 0:
-            # a traction: half the force at each corner of the face, on nodes with mass,
-            # in the field the particle uses at that node (field 0 outside its nodes)
-            for corner in range(2):
-                cx, cy = face_corner(pos, lp, F, geom, p, pbc_face[q], corner)
-                i, j, fx, fy = corner_cell(cx, cy, geom, g.shape[2] // nnx)
-                for b in range(2):
-                    wy = fy if b == 1 else 1.0 - fy
-                    for a in range(2):
-                        k = (j + b) * nnx + i + a
-                        pa = i + a - wij[p, 0]
-                        pb = j + b - wij[p, 1]
-                        fld = 0
-                        if cut[p] and 0 <= pa < NA and 0 <= pb < NA:
-                            fld = vfld[p, pb * NA + pa]
-                        if g[fld, GM, k] > 0.0:
-                            g[fld, row_c, k] += 0.5 * wy * (fx if a == 1 else 1.0 - fx) * f
+            # a traction: on the face's nodes that have mass, in the field the particle
+            # uses at that node (field 0 outside its nodes)
+            for m in range(8):
+                i, j, sw = face_node(pos, lp, F, geom, g.shape[2] // nnx, p, pbc_face[q], m)
+                pa = i - wij[p, 0]
+                pb = j - wij[p, 1]
+                fld = 0
+                if cut[p] and 0 <= pa < NA and 0 <= pb < NA:
+                    fld = vfld[p, pb * NA + pa]
+                if g[fld, GM, j * nnx + i] > 0.0:
+                    g[fld, row_c, j * nnx + i] += sw * f
             continue
         w = wc[p]
         for b in range(NA):
@@ -829,59 +824,63 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, 
                     g[fields[q], GFY, nodes[q]] += share * fy
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy")
 def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, clast, cext0,
-                cext1, ccrack, cfixed, nslot, dt, bounds, counts):
+                cext1, ccrack, cfixed, nslot, dt, bounds, counts, nch):
     """Each surface moves with the mean of the old and new velocity of the field on its
     side (mass-weighted, classic shape functions); a side that finds no field copies
     the other; the plane moves with the mean of the two surfaces.  All moves use the
-    positions before the step.  Returns a crack particle that left the grid, or -1."""
+    positions before the step (each crack particle's move is found independently, in
+    ``nch`` chunks).  Returns a crack particle that left the grid, or -1."""
     nf = g.shape[0]
     nc = cp.shape[1]
-    nodes = np.empty(4, dtype=np.int64)
-    fields = np.empty(4, dtype=np.int64)
-    weights = np.empty(4)
-    tested = np.empty(4, dtype=np.bool_)
-    ref_nodes = np.empty(4, dtype=np.int64)
-    ref_fields = np.empty(4, dtype=np.int64)
-    ref_tested = np.empty(4, dtype=np.bool_)
     moves = np.zeros((nc, 2, 2))
     found = np.zeros((nc, 2), dtype=np.bool_)
+    blocked = np.zeros(nch, dtype=np.int64)
     limit = 0.5 * min(geom[2], geom[3])
     cpx = cp[0]
     cpy = cp[1]
-    for k in range(nc):
-        if cfixed[ccrack[k]]:
-            continue
-        tx, ty, ux, uy, half = crack_frame(k, cpx, cpy, ccrack, cfirst, clast)
-        for side in range(2):
-            sgn = 1.0 if side == 0 else -1.0
-            sx = ca[0, k] if side == 0 else cb[0, k]
-            sy = ca[1, k] if side == 0 else cb[1, k]
-            total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy,
-                                cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot, nf, g,
-                                nodes, fields, weights, tested, ref_nodes, ref_fields,
-                                ref_tested)
-            if total <= 0.0:
+    for c in prange(nch):
+        nodes = np.empty(4, dtype=np.int64)
+        fields = np.empty(4, dtype=np.int64)
+        weights = np.empty(4)
+        tested = np.empty(4, dtype=np.bool_)
+        ref_nodes = np.empty(4, dtype=np.int64)
+        ref_fields = np.empty(4, dtype=np.int64)
+        ref_tested = np.empty(4, dtype=np.bool_)
+        for k in range(c * nc // nch, (c + 1) * nc // nch):
+            if cfixed[ccrack[k]]:
                 continue
-            vx = 0.0
-            vy = 0.0
-            for q in range(4):
-                wq = weights[q]
-                if wq > 0.0:
-                    f = fields[q]
-                    node = nodes[q]
-                    vx += wq * (gvn[f, 0, node] - 0.5 * ga[f, 0, node] * dt)
-                    vy += wq * (gvn[f, 1, node] - 0.5 * ga[f, 1, node] * dt)
-            mx = vx / total * dt
-            my = vy / total * dt
-            if abs(mx) > limit or abs(my) > limit:
-                counts[C_BLOCKED] += 1
-                mx = 0.0
-                my = 0.0
-            moves[k, side, 0] = mx
-            moves[k, side, 1] = my
-            found[k, side] = True
+            tx, ty, ux, uy, half = crack_frame(k, cpx, cpy, ccrack, cfirst, clast)
+            for side in range(2):
+                sgn = 1.0 if side == 0 else -1.0
+                sx = ca[0, k] if side == 0 else cb[0, k]
+                sy = ca[1, k] if side == 0 else cb[1, k]
+                total = _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords,
+                                    cxy, cpx, cpy, cfirst, clast, cext0, cext1, ccrack, nslot,
+                                    nf, g, nodes, fields, weights, tested, ref_nodes,
+                                    ref_fields, ref_tested)
+                if total <= 0.0:
+                    continue
+                vx = 0.0
+                vy = 0.0
+                for q in range(4):
+                    wq = weights[q]
+                    if wq > 0.0:
+                        f = fields[q]
+                        node = nodes[q]
+                        vx += wq * (gvn[f, 0, node] - 0.5 * ga[f, 0, node] * dt)
+                        vy += wq * (gvn[f, 1, node] - 0.5 * ga[f, 1, node] * dt)
+                mx = vx / total * dt
+                my = vy / total * dt
+                if abs(mx) > limit or abs(my) > limit:
+                    blocked[c] += 1
+                    mx = 0.0
+                    my = 0.0
+                moves[k, side, 0] = mx
+                moves[k, side, 1] = my
+                found[k, side] = True
+    counts[C_BLOCKED] += blocked.sum()
     out = -1
     for k in range(nc):
         if cfixed[ccrack[k]]:
@@ -1265,7 +1264,7 @@ def _run_steps(nsteps, t, dt, dt_first, dt_last, dt_update, plus, pending, flush
                                   rec_style, rec_value, rec_t0, rec_ftime, rec_force,
                                   rec_work, sym_out, sym_in, sym_dir, t, dt)
         out = move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst,
-                          clast, cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts)
+                          clast, cext0, cext1, ccrack, cfixed, nslot, dt, bounds, counts, nch)
         if out >= 0:
             return step + 1, STATUS_CRACK_LEFT_GRID, out, chords, cxy, cnodes
         old_cnodes = cnodes

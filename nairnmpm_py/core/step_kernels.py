@@ -117,15 +117,21 @@ def face_corner(pos, lp, F, geom, p, face, corner):
 
 
 @njit(cache=True, inline="always")
-def corner_cell(x, y, geom, nny):
-    """(column, row, fx, fy): the cell holding (x, y) (kept inside the grid of nny node
-    rows) and the fractions across it, for linear weights at a face corner."""
-    nnx = int(geom[4])
-    xi = (x - geom[0]) / geom[2]
-    eta = (y - geom[1]) / geom[3]
-    i = min(max(int(math.floor(xi)), 0), nnx - 2)
+def face_node(pos, lp, F, geom, nny, p, face, m):
+    """(column, row, weight) of the m-th (0-7) node a traction on face ``face`` of
+    particle p loads: node m % 4 of the cell holding corner m // 4, with half the
+    corner's linear weight there (the eight weights add up to 1).  The cell is kept
+    inside the grid of nny node rows."""
+    cx, cy = face_corner(pos, lp, F, geom, p, face, m // 4)
+    xi = (cx - geom[0]) / geom[2]
+    eta = (cy - geom[1]) / geom[3]
+    i = min(max(int(math.floor(xi)), 0), int(geom[4]) - 2)
     j = min(max(int(math.floor(eta)), 0), nny - 2)
-    return i, j, min(max(xi - i, 0.0), 1.0), min(max(eta - j, 0.0), 1.0)
+    fx = min(max(xi - i, 0.0), 1.0)
+    fy = min(max(eta - j, 0.0), 1.0)
+    a = m % 2
+    b = (m // 2) % 2
+    return i + a, j + b, 0.5 * (fx if a == 1 else 1.0 - fx) * (fy if b == 1 else 1.0 - fy)
 
 
 @njit(cache=True, error_model="numpy")
@@ -143,16 +149,11 @@ def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_face, 
         rec_force[r] += f
         row_c = GFX + pbc_dir[q]
         if pbc_face[q] > 0:
-            # a traction: half the force at each corner of the face, on nodes with mass
-            for corner in range(2):
-                cx, cy = face_corner(pos, lp, F, geom, p, pbc_face[q], corner)
-                i, j, fx, fy = corner_cell(cx, cy, geom, g.shape[1] // nnx)
-                for b in range(2):
-                    wy = fy if b == 1 else 1.0 - fy
-                    for a in range(2):
-                        k = (j + b) * nnx + i + a
-                        if g[GM, k] > 0.0:
-                            g[row_c, k] += 0.5 * wy * (fx if a == 1 else 1.0 - fx) * f
+            # a traction: on the face's nodes that have mass
+            for m in range(8):
+                i, j, sw = face_node(pos, lp, F, geom, g.shape[1] // nnx, p, pbc_face[q], m)
+                if g[GM, j * nnx + i] > 0.0:
+                    g[row_c, j * nnx + i] += sw * f
             continue
         xi = (pos[0, p] - geom[0]) / geom[2]
         eta = (pos[1, p] - geom[1]) / geom[3]
