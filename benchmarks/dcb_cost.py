@@ -17,8 +17,8 @@ functions, and records for each run the wall time, steps, particles and
 
 Writes ``dcb_cost.csv`` and ``dcb_cost.png`` (RMS error against wall time) to --out.
 A run whose folder already holds a finished ``run.json`` is read, not rerun
-(--rerun forces it).  Wall times are warm starts (the kernels are compiled on a
-short coarse run first) and need an idle machine.
+(--rerun forces it).  Wall times are warm starts (the kernels are compiled on 0.01 ms
+of the same scene first) and need an idle machine.
 """
 from __future__ import annotations
 
@@ -68,8 +68,10 @@ def run_case(spacing: float, shape: str, tmax: float, work: Path, threads: int,
         from nairnmpm_py.outputs.defaults import default_outputs
         numba.set_num_threads(threads)
         # compile (or load from the cache) this scene's kernels on a few steps of the
-        # coarsest version first, so the wall time is that of a warm start
-        warm = load_simulation(make_input(1.0, shape, 0.01, work / f"warmup_{shape}"))
+        # same scene first, so the wall time is that of a warm start (the load
+        # expressions hold the spacing's row positions, and each expression set has
+        # kernels of its own: a coarser warm-up left a cold compile in the timing)
+        warm = load_simulation(make_input(spacing, shape, 0.01, work / f"warmup_{shape}"))
         warm.run([])
         path = make_input(spacing, shape, tmax, folder)
         sim = load_simulation(path)
