@@ -17,9 +17,9 @@ entities from the sweep's ``summary.csv`` (J_tip,c, J_B, sigma_c, Tprop), and dr
 into ``OUT/dcb_fig7.png`` ... ``dcb_fig10.png`` and a CSV of the checks of issue 4:
 R on the plateau against J_tip,c + J_B, the RMS of R - Eq 22 over delta/delta_c in
 0.1-0.95 in percent of J_tip,c, the median J_tip at growth, and the steady zone length.
-The moment on each arm is read from the applied loads in ``global.csv``: the force
-of the upper arm's outer row (|F|, its two components) times the distance between
-the two loaded rows of that arm (template entities ``ytop`` - ``qcs``).
+The moment on each arm is global.csv's ``moment_Nmm_`` column of that arm (the
+moment of the arm's two loaded rows; results written before those columns existed
+need a rerun).
 """
 from __future__ import annotations
 
@@ -61,15 +61,12 @@ def load_line_opening(d: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def moment(d: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(time ms, moment N mm on the upper arm) from the applied loads."""
+    """(time ms, moment N mm on the upper arm): global.csv's first ``moment_Nmm_``
+    column (one per arm; the upper arm's rows come first in the template)."""
     from nairnmpm_py.analysis.results import read_csv_columns
-    from nairnmpm_py.sweep import INPUT_NAME, declared_entities
-    ent = declared_entities((d / INPUT_NAME).read_text())
-    lever = float(ent["ytop"][1]) - float(ent["qcs"][1])
     cols, g = read_csv_columns(d / "global.csv")
-    loads = [c for c in cols if c.startswith("load_N_")]
-    # the first two load records are the upper arm's outer row (x and y components)
-    return g["time_ms"], np.hypot(g[loads[0]], g[loads[1]]) * lever
+    arm = next(c for c in cols if c.startswith("moment_Nmm_"))
+    return g["time_ms"], np.abs(g[arm])
 
 
 def main() -> None:
