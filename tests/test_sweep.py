@@ -117,16 +117,21 @@ def test_run_sweep_function_returns_statuses_in_table_order(tmp_path):
 
 
 def test_sweep_plots_overlay_crack_results(tmp_path):
-    """Members with cracks.csv get J_tip / growth and R-curve overlays."""
+    """Members with cracks.csv get J_tip / growth and R-curve overlays (R against
+    growth and against the notch-root opening), and zone length against the moment
+    where global.csv has a moment column."""
     from nairnmpm_py.analysis.sweep_plots import plot_sweep
     (tmp_path / "summary.csv").write_text("name,exit_status\na,done\nb,done\n")
-    head = "time_ms,crack,tip,crack_growth_mm,J_tip_J_m2,R_J_m2,event\n"
+    head = "time_ms,crack,tip,crack_growth_mm,J_tip_J_m2,R_J_m2,cod_notch0_mm,zone_length_mm,event\n"
     for name, jc in (("a", 100.0), ("b", 200.0)):
         d = tmp_path / name
         d.mkdir()
-        (d / "global.csv").write_text("time_ms,step,kinetic_energy_J\n0,0,0\n1,10,1e-3\n")
-        rows = [f"{t},1,\"end\",0,{jc * t / 2},,\"archive\"" for t in (0.0, 1.0)]
-        rows += [f"{1 + k / 10},1,\"end\",{k * 0.5},{jc},{jc + 10 * k},\"growth\"" for k in range(5)]
+        (d / "global.csv").write_text("time_ms,step,kinetic_energy_J,moment_Nmm_bc1_bc2\n"
+                                      "0,0,0,0\n1,10,1e-3,-5\n2,20,2e-3,-9\n")
+        rows = [f"{t},1,\"end\",0,{jc * t / 2},,0,0,\"archive\"" for t in (0.0, 1.0)]
+        rows += [f"{1 + k / 10},1,\"end\",{k * 0.5},{jc},{jc + 10 * k},{0.01 * k},{k},\"growth\""
+                 for k in range(5)]
         (d / "cracks.csv").write_text(head + "\n".join(rows) + "\n")
     written = {p.name for p in plot_sweep(tmp_path)}
-    assert {"sweep_cracks.png", "sweep_r_curve.png", "sweep_energies.png"} <= written
+    assert {"sweep_cracks.png", "sweep_r_curve.png", "sweep_energies.png", "sweep_r_cod.png",
+            "sweep_zone_moment.png"} <= written

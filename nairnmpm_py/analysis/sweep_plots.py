@@ -1,7 +1,9 @@
 """Overlay plots of a sweep folder (``summary.csv`` plus one results folder per member):
 energies against time, each load against displacement (or time) and, for members with
-cracks, J_tip and crack growth against time and R against crack growth; one line per
-member, legend by member name."""
+cracks, J_tip and crack growth against time, R against crack growth and against the
+opening at the original notch root (the seed paper's Figs 8B and 7), and the
+traction-zone length against the moment (Fig 10); one line per member, legend by
+member name."""
 from __future__ import annotations
 
 import csv
@@ -88,15 +90,18 @@ def plot_sweep(folder, out_folder=None) -> list[Path]:
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
         _save(fig, out / f"sweep_load_{_safe(bc)}.png", written)
-    _plot_crack_overlays(folder, [name for name, _, _ in members], out, written)
+    _plot_crack_overlays(folder, {name: g for name, g, _ in members}, out, written)
     return written
 
 
-def _plot_crack_overlays(folder: Path, names: list[str], out: Path, written: list[Path]) -> None:
+def _plot_crack_overlays(folder: Path, globals_: dict, out: Path, written: list[Path]) -> None:
     """``sweep_cracks.png``: J_tip and crack growth against time (first tip of each
-    member); ``sweep_r_curve.png``: R (Eq 15) against growth at the growth steps."""
+    member); at the growth steps, ``sweep_r_curve.png``: R (Eq 15) against growth,
+    ``sweep_r_cod.png``: R against the opening at the original notch root, and
+    ``sweep_zone_moment.png``: zone length against the first moment column of
+    global.csv (its magnitude, at the growth times)."""
     tables = []
-    for name in names:
+    for name in globals_:
         _, c = _member_csv(folder / name / "cracks.csv")
         if c is None:
             continue
@@ -127,3 +132,26 @@ def _plot_crack_overlays(folder: Path, names: list[str], out: Path, written: lis
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
         _save(fig, out / "sweep_r_curve.png", written)
+        fig, (ax,) = _figure()
+        for name, c in grown:
+            g = c["event"] == "growth"
+            ax.plot(c["cod_notch0_mm"][g], c["R_J_m2"][g], ".-", ms=3, label=name)
+        ax.set_xlabel("opening at the original notch root (mm)")
+        ax.set_ylabel("R (J/m^2)")
+        ax.legend(fontsize="small")
+        ax.grid(alpha=0.3)
+        _save(fig, out / "sweep_r_cod.png", written)
+        with_moment = [(n, c, next(k for k in globals_[n] if k.startswith("moment_Nmm_")))
+                       for n, c in grown if any(k.startswith("moment_Nmm_") for k in globals_[n])]
+        if with_moment:
+            fig, (ax,) = _figure()
+            for name, c, col in with_moment:
+                g = c["event"] == "growth"
+                gl = globals_[name]
+                moment = np.interp(c["time_ms"][g], gl["time_ms"], np.abs(gl[col]))
+                ax.plot(moment, c["zone_length_mm"][g], ".-", ms=3, label=name)
+            ax.set_xlabel("moment (N mm)")
+            ax.set_ylabel("traction zone length (mm)")
+            ax.legend(fontsize="small")
+            ax.grid(alpha=0.3)
+            _save(fig, out / "sweep_zone_moment.png", written)
