@@ -121,37 +121,35 @@ def _plot_crack_overlays(folder: Path, globals_: dict, out: Path, written: list[
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
     _save(fig, out / "sweep_cracks.png", written)
-    grown = [(n, c) for n, c in tables if np.any(c["event"] == "growth")]
-    if grown:
-        fig, (ax,) = _figure()
-        for name, c in grown:
-            g = c["event"] == "growth"
-            ax.plot(c["crack_growth_mm"][g], c["R_J_m2"][g], ".-", ms=3, label=name)
-        ax.set_xlabel("crack growth (mm)")
-        ax.set_ylabel("R (J/m^2)")
-        ax.legend(fontsize="small")
-        ax.grid(alpha=0.3)
-        _save(fig, out / "sweep_r_curve.png", written)
-        fig, (ax,) = _figure()
-        for name, c in grown:
-            g = c["event"] == "growth"
-            ax.plot(c["cod_notch0_mm"][g], c["R_J_m2"][g], ".-", ms=3, label=name)
-        ax.set_xlabel("opening at the original notch root (mm)")
-        ax.set_ylabel("R (J/m^2)")
-        ax.legend(fontsize="small")
-        ax.grid(alpha=0.3)
-        _save(fig, out / "sweep_r_cod.png", written)
-        with_moment = [(n, c, next(k for k in globals_[n] if k.startswith("moment_Nmm_")))
-                       for n, c in grown if any(k.startswith("moment_Nmm_") for k in globals_[n])]
-        if with_moment:
-            fig, (ax,) = _figure()
-            for name, c, col in with_moment:
-                g = c["event"] == "growth"
-                gl = globals_[name]
-                moment = np.interp(c["time_ms"][g], gl["time_ms"], np.abs(gl[col]))
-                ax.plot(moment, c["zone_length_mm"][g], ".-", ms=3, label=name)
-            ax.set_xlabel("moment (N mm)")
-            ax.set_ylabel("traction zone length (mm)")
-            ax.legend(fontsize="small")
-            ax.grid(alpha=0.3)
-            _save(fig, out / "sweep_zone_moment.png", written)
+    # at the growth steps: (x, y) of each member for one overlay
+    grown = [(n, c, c["event"] == "growth") for n, c in tables if np.any(c["event"] == "growth")]
+    if not grown:
+        return
+    _growth_overlay([(n, c["crack_growth_mm"][g], c["R_J_m2"][g]) for n, c, g in grown],
+                    "crack growth (mm)", "R (J/m^2)", out / "sweep_r_curve.png", written)
+    _growth_overlay([(n, c["cod_notch0_mm"][g], c["R_J_m2"][g]) for n, c, g in grown],
+                    "opening at the original notch root (mm)", "R (J/m^2)",
+                    out / "sweep_r_cod.png", written)
+    lines = []
+    for name, c, g in grown:
+        gl = globals_[name]
+        col = next((k for k in gl if k.startswith("moment_Nmm_")), None)
+        if col is not None:
+            moment = np.interp(c["time_ms"][g], gl["time_ms"], np.abs(gl[col]))
+            lines.append((name, moment, c["zone_length_mm"][g]))
+    if lines:
+        _growth_overlay(lines, "moment (N mm)", "traction zone length (mm)",
+                        out / "sweep_zone_moment.png", written)
+
+
+def _growth_overlay(lines: list, xlabel: str, ylabel: str, path: Path,
+                    written: list[Path]) -> None:
+    """One overlay of (name, x, y) lines, points at the growth steps."""
+    fig, (ax,) = _figure()
+    for name, x, y in lines:
+        ax.plot(x, y, ".-", ms=3, label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize="small")
+    ax.grid(alpha=0.3)
+    _save(fig, path, written)
