@@ -732,6 +732,15 @@ def _mirror_surface_nodes(sx, sy, geom, crack, nslot, nf, ref_nodes, ref_fields,
 
 
 @njit(cache=True, inline="always")
+def _side_scratch():
+    """Work arrays of ``_side_nodes``: nodes, fields, weights, tested and their
+    mirror-surface counterparts (four nodes each)."""
+    return (np.empty(4, dtype=np.int64), np.empty(4, dtype=np.int64), np.empty(4),
+            np.empty(4, dtype=np.bool_), np.empty(4, dtype=np.int64),
+            np.empty(4, dtype=np.int64), np.empty(4, dtype=np.bool_))
+
+
+@njit(cache=True, inline="always")
 def _side_nodes(k, side, sx, sy, ux, uy, sgn, geom, ncx, ncy, cstart, chords, cxy, cpx, cpy,
                 cfirst, clast, cext0, cext1, ccrack, nslot, nf, g, nodes, fields, weights,
                 tested, ref_nodes, ref_fields, ref_tested):
@@ -760,13 +769,7 @@ def crack_tractions(g, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfirst, 
     shared by S * m, all of it delivered), with history, unloading to the origin and
     failure at delta_c per mode."""
     nf = g.shape[0]
-    nodes = np.empty(4, dtype=np.int64)
-    fields = np.empty(4, dtype=np.int64)
-    weights = np.empty(4)
-    tested = np.empty(4, dtype=np.bool_)
-    ref_nodes = np.empty(4, dtype=np.int64)
-    ref_fields = np.empty(4, dtype=np.int64)
-    ref_tested = np.empty(4, dtype=np.bool_)
+    nodes, fields, weights, tested, ref_nodes, ref_fields, ref_tested = _side_scratch()
     cpx = cp[0]
     cpy = cp[1]
     for k in range(cp.shape[1]):
@@ -841,13 +844,7 @@ def move_cracks(g, ga, gvn, geom, ncx, ncy, cstart, chords, cxy, cp, ca, cb, cfi
     cpx = cp[0]
     cpy = cp[1]
     for c in prange(nch):
-        nodes = np.empty(4, dtype=np.int64)
-        fields = np.empty(4, dtype=np.int64)
-        weights = np.empty(4)
-        tested = np.empty(4, dtype=np.bool_)
-        ref_nodes = np.empty(4, dtype=np.int64)
-        ref_fields = np.empty(4, dtype=np.int64)
-        ref_tested = np.empty(4, dtype=np.bool_)
+        nodes, fields, weights, tested, ref_nodes, ref_fields, ref_tested = _side_scratch()
         for k in range(c * nc // nch, (c + 1) * nc // nch):
             if cfixed[ccrack[k]]:
                 continue
