@@ -11,8 +11,10 @@ seed paper's Eqs 11-13:
 
 W_B(x) is the work the crack-face tractions have done per unit area at x: the area
 under the envelope while loading, less what was given back along the linear unloading
-to the origin (seed Appendix).  The root is the crack particle farthest from the tip
-in the unbroken run of traction-carrying particles that starts at (or next to) the tip.
+to the origin (seed Appendix).  The root particle is the one farthest from the tip in
+the unbroken run of traction-carrying particles that starts at (or next to) the tip;
+the notch root itself is the edge of that particle's share of crack length, halfway
+to the next particle (``root_edge``), where W_B(root) and the root's opening are taken.
 """
 from __future__ import annotations
 
@@ -182,16 +184,18 @@ class CrackScene:
         run = walk[start:start + (int(ends[0]) if ends.size else walk.size - start)]
         return run.tolist(), int(run[-1])
 
-    def traction_work(self, k: int) -> float:
-        """W_B (J/m^2) done by the tractions of crack particle k so far."""
+    def traction_work(self, k: int, dn: float | None = None) -> float:
+        """W_B (J/m^2) done by the tractions of crack particle k so far; ``dn`` puts
+        another opening on k's law and history (the root's edge, ``root_edge``)."""
         law_index = int(self.cracks.law[k])
         if law_index < 0 or law_index not in self.laws:
             return 0.0
         law = self.laws[law_index]
-        if self.state[k] == FAILED:
+        if dn is None:
+            dn = self.cod_at(k)[0]
+        h = max(self.hist[0, k], dn)
+        if self.state[k] == FAILED or h >= law.delta_c(1):
             return float(law.area(1))
-        dn, _ = self.cod_at(k)
-        h = self.hist[0, k]
         if dn >= h:
             return float(law.work_to(max(dn, 0.0), 1))
         if h <= 0.0:
@@ -199,19 +203,34 @@ class CrackScene:
         s_h = float(law.envelope(h, 1))
         return float(law.work_to(h, 1)) - 0.5 * s_h * h * 1000.0 * (1.0 - (max(dn, 0.0) / h) ** 2)
 
-    def recoverable_work(self, k: int) -> float:
+    def recoverable_work(self, k: int, dn: float | None = None) -> float:
         """W_B^(r) (J/m^2): what linear unloading from the current state gives back."""
         law_index = int(self.cracks.law[k])
         if law_index < 0 or law_index not in self.laws or self.state[k] != ACTIVE:
             return 0.0
         law = self.laws[law_index]
-        dn, _ = self.cod_at(k)
-        h = self.hist[0, k]
-        if h <= 0.0:
+        if dn is None:
+            dn = self.cod_at(k)[0]
+        h = max(self.hist[0, k], dn)
+        if h <= 0.0 or h >= law.delta_c(1):
             return 0.0
         s_h = float(law.envelope(h, 1))
         d = min(max(dn, 0.0), h)
         return 0.5 * s_h / h * d * d * 1000.0
+
+    def root_edge(self, tip: Tip, k: int) -> tuple[np.ndarray, float]:
+        """(point, normal opening) where the traction zone ends behind crack particle k:
+        a law particle's force acts over half of each segment beside it, so the zone
+        reaches halfway to the next particle away from the tip, and the opening there
+        is the mean of the two.  A particle without a law, or the last one of its
+        crack, stands for itself."""
+        cs = self.cracks
+        c = cs.crack[k]
+        nxt = k - 1 if tip.end == "end" else k + 1
+        if int(cs.law[k]) < 0 or not cs.first[c] <= nxt < cs.first[c] + cs.count[c]:
+            return cs.plane[:, k].copy(), self.cod_at(k)[0]
+        return (0.5 * (cs.plane[:, k] + cs.plane[:, nxt]),
+                0.5 * (self.cod_at(k)[0] + self.cod_at(nxt)[0]))
 
     def cod_at(self, k: int) -> tuple[float, float]:
         """(normal, tangential) opening (mm) at crack particle k."""
@@ -278,9 +297,9 @@ class CrackScene:
         key = (tip.crack, tip.end)
         xt = self._tip_point(tip)
         zone, root = self.zone(tip)
-        root_xy = cs.plane[:, root]
-        w_root = self.traction_work(root) if zone else 0.0
-        w_rec = self.recoverable_work(root) if zone else 0.0
+        root_xy, cod_root = self.root_edge(tip, root)
+        w_root = self.traction_work(root, cod_root) if zone else 0.0
+        w_rec = self.recoverable_work(root, cod_root) if zone else 0.0
         row = {"time_ms": sim.time, "crack": tip.crack + 1, "tip": tip.end,
                "contour_cells": size,
                "tip_x_mm": float(xt[0]), "tip_y_mm": float(xt[1]),
@@ -290,8 +309,8 @@ class CrackScene:
                "J_contour_J_m2": math.nan, "J_tip_J_m2": math.nan, "J_ff_J_m2": math.nan,
                "W_B_crossing_J_m2": math.nan,
                "W_B_root_J_m2": w_root, "W_B_rec_root_J_m2": w_rec, "R_J_m2": math.nan,
-               "cod_root_mm": self.cod_at(root)[0],
-               "cod_notch0_mm": self.cod_at(self._index_of(self.initial_root[key]))[0],
+               "cod_root_mm": cod_root,
+               "cod_notch0_mm": self.root_edge(tip, self._index_of(self.initial_root[key]))[1],
                "KI_MPa_sqrt_m": math.nan, "KII_MPa_sqrt_m": math.nan, "event": "archive",
                "error": ""}
         try:
