@@ -104,3 +104,22 @@ def test_unknown_criterion_is_an_input_error(tmp_path, capsys):
     path.write_text(text)
     assert main(["check", str(path)]) == 2
     assert "no propagation criterion of that number" in capsys.readouterr().err
+
+
+def test_run_json_carries_the_R_curve_theory(tmp_path):
+    """run.json's r_curve_theory: Eq 16 for the tip's new-particle law and J_tip,c,
+    which ``nairnmpm plot`` draws dashed beside the simulated R (Fig 7)."""
+    import json
+
+    from nairnmpm_py.analysis.rcurve import R_triangular
+    path = sent_growing(tmp_path, tprop=True, t_end=0.05)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "-o", str(out), "-q"]) == 0
+    (th,) = json.loads((out / "run.json").read_text())["r_curve_theory"]
+    assert (th["crack"], th["tip"], th["J_tip_c_J_m2"]) == (1, "end", JIC)
+    # "triangle": sigma 5 MPa, delta_c 0.04 mm, peak at the default 0.225926299 delta_c
+    assert th["delta_c_mm"] == pytest.approx(0.04)
+    assert th["J_B_J_m2"] == pytest.approx(0.5 * 5 * 0.04 * 1000)
+    d, R = np.array(th["cod_mm"]), np.array(th["R_J_m2"])
+    assert d[-1] == pytest.approx(1.2 * 0.04)
+    np.testing.assert_allclose(R, R_triangular(d, JIC, 100.0, 0.04, 0.225926299 * 0.04), rtol=1e-9)

@@ -3,7 +3,9 @@ Dask cluster; a bad member is reported in summary.csv and does not stop the othe
 from __future__ import annotations
 
 import csv
+import json
 
+import numpy as np
 import pytest
 
 from nairnmpm_py.cli import main
@@ -126,12 +128,29 @@ def test_sweep_plots_overlay_crack_results(tmp_path):
     for name, jc in (("a", 100.0), ("b", 200.0)):
         d = tmp_path / name
         d.mkdir()
-        (d / "global.csv").write_text("time_ms,step,kinetic_energy_J,moment_Nmm_bc1_bc2\n"
-                                      "0,0,0,0\n1,10,1e-3,-5\n2,20,2e-3,-9\n")
+        (d / "global.csv").write_text("time_ms,step,kinetic_energy_J,moment_Nmm_bc1_bc2,"
+                                      "moment_Nmm_bc3_bc4,opening_mm_bc1_bc2_bc3_bc4\n"
+                                      "0,0,0,0,0,0\n1,10,1e-3,-5,5,0.1\n2,20,2e-3,-9,9,0.2\n")
+        (d / "run.json").write_text(json.dumps({"r_curve_theory": [
+            {"crack": 1, "tip": "end", "cod_mm": [0, 0.05], "R_J_m2": [jc, jc + 10]}]}))
         rows = [f"{t},1,\"end\",0,{jc * t / 2},,0,0,\"archive\"" for t in (0.0, 1.0)]
         rows += [f"{1 + k / 10},1,\"end\",{k * 0.5},{jc},{jc + 10 * k},{0.01 * k},{k},\"growth\""
                  for k in range(5)]
         (d / "cracks.csv").write_text(head + "\n".join(rows) + "\n")
     written = {p.name for p in plot_sweep(tmp_path)}
     assert {"sweep_cracks.png", "sweep_r_curve.png", "sweep_energies.png", "sweep_r_cod.png",
-            "sweep_zone_moment.png"} <= written
+            "sweep_zone_moment.png", "sweep_load_bc1_bc2.png", "sweep_load_bc3_bc4.png"} <= written
+
+
+def test_moments_plot_against_the_opening_of_their_groups():
+    """A moment column pairs with the opening_mm_ column naming its group (Figs 8A, 9A);
+    a load column with its own disp_mm_ column; anything else with nothing."""
+    from nairnmpm_py.analysis.plots import load_displacement
+    g = {"moment_Nmm_bc1_bc2": np.array([0.0, 1.0]), "moment_Nmm_bc3_bc4": np.array([0.0, -1.0]),
+         "moment_Nmm_bc5_bc6": np.array([0.0, 2.0]), "opening_mm_bc1_bc2_bc3_bc4": np.array([0.0, 0.3]),
+         "load_N_bc7_y": np.array([0.0, 4.0]), "disp_mm_bc7_y": np.array([0.0, 0.01])}
+    for col in ("moment_Nmm_bc1_bc2", "moment_Nmm_bc3_bc4"):
+        x, label, used = load_displacement(g, col)
+        assert used == "opening_mm_bc1_bc2_bc3_bc4" and label == "load-line opening (mm)"
+    assert load_displacement(g, "moment_Nmm_bc5_bc6")[0] is None
+    assert load_displacement(g, "load_N_bc7_y")[2] == "disp_mm_bc7_y"

@@ -19,6 +19,7 @@ ENERGY_COLUMNS = {"kinetic_energy_J": "kinetic", "strain_energy_J": "strain",
                   "external_work_J": "external work"}
 LOAD_PREFIXES = {"load_N_": "load (N)", "moment_Nmm_": "moment (N mm)"}
 DISP_PREFIX = "disp_mm_"
+OPENING_PREFIX = "opening_mm_"
 
 # unit tokens as they appear in column names (longest first) and how to print them
 UNIT_TOKENS = [("MPa_sqrt_m", "MPa m^1/2"), ("J_m2", "J/m^2"), ("mm_s", "mm/s"),
@@ -73,6 +74,33 @@ def _nonzero(a) -> bool:
 
 
 # ---- global.csv ------------------------------------------------------------------
+def load_displacement(g: dict, load_col: str) -> tuple[np.ndarray | None, str, str | None]:
+    """(x values, axis label, column) to plot a load column against: the condition's
+    own ``disp_mm_`` column, or for a moment the opening of the two loaded groups
+    (``opening_mm_<a>_<b>`` naming the moment's group; seed Figs 8A and 9A); None
+    when there is neither."""
+    for prefix in LOAD_PREFIXES:
+        if load_col.startswith(prefix):
+            bc = load_col[len(prefix):]
+            break
+    else:
+        return None, "", None
+    disp_col = DISP_PREFIX + bc
+    if disp_col in g and _nonzero(g[disp_col]):
+        return g[disp_col], "displacement (mm)", disp_col
+    if prefix == "moment_Nmm_":
+        for col in g:
+            if col.startswith(OPENING_PREFIX) and _names_group(col, bc) and _nonzero(g[col]):
+                return g[col], "load-line opening (mm)", col
+    return None, "", None
+
+
+def _names_group(opening_col: str, group: str) -> bool:
+    """Does ``opening_mm_<a>_<b>`` name ``group`` as a or b?"""
+    pair = opening_col[len(OPENING_PREFIX):]
+    return pair.startswith(group + "_") or pair.endswith("_" + group)
+
+
 def _plot_energies(g: dict, out: Path, written: list[Path]) -> None:
     if "time_ms" not in g or not any(c in g for c in ENERGY_COLUMNS):
         return
@@ -99,20 +127,19 @@ def _plot_loads(g: dict, columns: list[str], out: Path, written: list[Path]) -> 
         if prefix is None:
             continue
         bc = col[len(prefix):]
-        disp_col = DISP_PREFIX + bc
-        used.update({col, disp_col})
+        used.update({col, DISP_PREFIX + bc})
         load = g[col]
         if not _nonzero(load) or t is None:
             continue
-        disp = g.get(disp_col)
-        with_disp = disp is not None and _nonzero(disp)
-        fig, axes = _figure(2 if with_disp else 1)
+        disp, disp_label, disp_col = load_displacement(g, col)
+        used.add(disp_col)
+        fig, axes = _figure(2 if disp is not None else 1)
         axes[0].plot(t, load)
         axes[0].set_xlabel(TIME_LABEL)
         axes[0].set_ylabel(LOAD_PREFIXES[prefix])
-        if with_disp:
+        if disp is not None:
             axes[1].plot(disp, load)
-            axes[1].set_xlabel("displacement (mm)")
+            axes[1].set_xlabel(disp_label)
             axes[1].set_ylabel(LOAD_PREFIXES[prefix])
         for ax in axes:
             ax.grid(alpha=0.3)
@@ -161,7 +188,17 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def _plot_cracks(c: dict, out: Path, written: list[Path]) -> None:
+def theory_lines(run: dict) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(label, opening mm, R J/m^2) of run.json's R-curve theory per growing tip (seed
+    Eq 16; Eq 22 for the cubic law)."""
+    lines = []
+    for th in run.get("r_curve_theory", []):
+        lines.append((f"crack {th['crack']} {th['tip']}", np.asarray(th["cod_mm"], dtype=float),
+                      np.asarray(th["R_J_m2"], dtype=float)))
+    return lines
+
+
+def _plot_cracks(c: dict, out: Path, written: list[Path], run: dict | None = None) -> None:
     if "time_ms" not in c or len(c["time_ms"]) == 0:
         return
     series = _tip_series(c)
@@ -195,6 +232,8 @@ def _plot_cracks(c: dict, out: Path, written: list[Path]) -> None:
         for label, rows in series:
             ok = rows[np.isfinite(c["R_J_m2"][rows])]
             ax.plot(c["cod_notch0_mm"][ok], c["R_J_m2"][ok], ".-", label=f"R, {label}")
+        for label, d, R in theory_lines(run or {}):
+            ax.plot(d, R, "k--", lw=1, label=f"theory (Eq 16/22), {label}")
         ax.set_xlabel("COD at the original notch root (mm)")
         ax.set_ylabel("R (J/m^2)")
         ax.legend(fontsize="small")
@@ -254,7 +293,7 @@ def plot_results(folder, out_folder=None) -> list[Path]:
         used = _plot_loads(g, cols, out, written)
         _plot_extras(g, cols, used, out, written)
     if res.cracks:
-        _plot_cracks(res.cracks, out, written)
+        _plot_cracks(res.cracks, out, written, res.run)
     if res.jcontours:
         _plot_jcontours(res.jcontours, res.jcontour_columns, out, written)
     return written

@@ -1,18 +1,20 @@
 """Overlay plots of a sweep folder (``summary.csv`` plus one results folder per member):
 energies against time, each load against displacement (or time) and, for members with
 cracks, J_tip and crack growth against time, R against crack growth and against the
-opening at the original notch root (the seed paper's Figs 8B and 7), and the
-traction-zone length against the moment (Fig 10); one line per member, legend by
-member name."""
+opening at the original notch root (the seed paper's Figs 8B and 7, with each
+member's Eq 16/22 theory dashed), the traction-zone length against the moment (Fig 10),
+and each moment against the load-line opening (Figs 8A and 9A); one line per member,
+legend by member name."""
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import numpy as np
 
-from .plots import (DISP_PREFIX, ENERGY_COLUMNS, LOAD_PREFIXES, TIME_LABEL, _figure,
-                    _nonzero, _safe, _save)
+from .plots import (ENERGY_COLUMNS, LOAD_PREFIXES, TIME_LABEL, _figure, _nonzero, _safe,
+                    _save, load_displacement, theory_lines)
 from .results import read_csv_columns
 
 SUMMARY = "summary.csv"
@@ -76,15 +78,16 @@ def plot_sweep(folder, out_folder=None) -> list[Path]:
     for col in load_cols:
         prefix = next(p for p in LOAD_PREFIXES if col.startswith(p))
         bc = col[len(prefix):]
-        disp_col = DISP_PREFIX + bc
         have = [(n, g) for n, g, _ in members if col in g and _nonzero(g[col])]
         if not have:
             continue
-        vs_disp = all(disp_col in g and _nonzero(g[disp_col]) for _, g in have)
+        disps = [load_displacement(g, col) for _, g in have]
+        labels = {label for _, label, _ in disps}
+        vs_disp = all(d is not None for d, _, _ in disps) and len(labels) == 1
         fig, (ax,) = _figure()
-        for name, g in have:
-            ax.plot(g[disp_col] if vs_disp else g["time_ms"], g[col], label=name)
-        ax.set_xlabel("displacement (mm)" if vs_disp else TIME_LABEL)
+        for (name, g), (disp, _, _) in zip(have, disps):
+            ax.plot(disp if vs_disp else g["time_ms"], g[col], label=name)
+        ax.set_xlabel(labels.pop() if vs_disp else TIME_LABEL)
         ax.set_ylabel(LOAD_PREFIXES[prefix])
         ax.set_title(f"boundary condition {bc}")
         ax.legend(fontsize="small")
@@ -127,9 +130,11 @@ def _plot_crack_overlays(folder: Path, globals_: dict, out: Path, written: list[
         return
     _growth_overlay([(n, c["crack_growth_mm"][g], c["R_J_m2"][g]) for n, c, g in grown],
                     "crack growth (mm)", "R (J/m^2)", out / "sweep_r_curve.png", written)
+    theory = {n: theory_lines(_member_run(folder / n)) for n, _, _ in grown}
     _growth_overlay([(n, c["cod_notch0_mm"][g], c["R_J_m2"][g]) for n, c, g in grown],
                     "opening at the original notch root (mm)", "R (J/m^2)",
-                    out / "sweep_r_cod.png", written)
+                    out / "sweep_r_cod.png", written,
+                    dashed={n: lines[0][1:] for n, lines in theory.items() if lines})
     lines = []
     for name, c, g in grown:
         gl = globals_[name]
@@ -142,12 +147,27 @@ def _plot_crack_overlays(folder: Path, globals_: dict, out: Path, written: list[
                         out / "sweep_zone_moment.png", written)
 
 
+def _member_run(folder: Path) -> dict:
+    try:
+        return json.loads((folder / "run.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
 def _growth_overlay(lines: list, xlabel: str, ylabel: str, path: Path,
-                    written: list[Path]) -> None:
-    """One overlay of (name, x, y) lines, points at the growth steps."""
+                    written: list[Path], dashed: dict | None = None) -> None:
+    """One overlay of (name, x, y) lines, points at the growth steps; ``dashed`` maps a
+    name to an (x, y) curve drawn dashed in its colour (the theory for that member)."""
     fig, (ax,) = _figure()
+    dashed = dashed or {}
     for name, x, y in lines:
-        ax.plot(x, y, ".-", ms=3, label=name)
+        (line,) = ax.plot(x, y, ".-", ms=3, label=name)
+        if name in dashed:
+            ax.plot(*dashed[name], "--", lw=1, color=line.get_color())
+    if dashed:
+        ax.plot([], [], "k--", lw=1, label="theory (Eq 16/22)")
+        right = max(float(np.nanmax(x)) for _, x, _ in lines if len(x))
+        ax.set_xlim(0.0, right * 1.02)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.legend(fontsize="small")

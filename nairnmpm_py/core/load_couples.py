@@ -10,7 +10,9 @@ uncracked beam with two end forces it is the couple they make.
 Each load condition's total force (``load_N_`` column) is taken to act at the current
 centroid of its particles, and the moment (N mm, counter-clockwise positive) is taken
 about the centroid of the group's shapes.  For a couple (zero net force) the reference
-point does not matter.  This is exact when the particles of one condition carry equal
+point does not matter.  When there are exactly two groups, global.csv also gets
+``opening_mm_<group>_<group>``: how far the groups' centres have moved apart (the
+load-line opening of a DCB's arms).  This is exact when the particles of one condition carry equal
 loads (constant, ``<net/>`` or any load of time alone); a style-6 load that depends on
 the particle (x, y, q) differs between particles only by the spread of those values.
 """
@@ -69,7 +71,7 @@ def couple_moment(couple: LoadCouple, records, rec_force: np.ndarray,
                   positions: np.ndarray) -> float:
     """Moment (N mm, counter-clockwise) of a group's loads about its centroid."""
     at = np.array([positions[:, m].mean(axis=1) for m in couple.members])
-    c = at.mean(axis=0)
+    c = at.mean(axis=0)   # = group_centre
     moment = 0.0
     for k, r in enumerate(couple.records):
         f = float(rec_force[r])
@@ -78,6 +80,22 @@ def couple_moment(couple: LoadCouple, records, rec_force: np.ndarray,
         else:
             moment += (at[k, 0] - c[0]) * f
     return moment
+
+
+def group_centre(couple: LoadCouple, positions: np.ndarray) -> np.ndarray:
+    """The point a group's moment is taken about: the mean of its conditions' particle
+    centroids."""
+    return np.mean([positions[:, m].mean(axis=1) for m in couple.members], axis=0)
+
+
+def couples_opening(a: LoadCouple, b: LoadCouple, positions: np.ndarray,
+                    initial: np.ndarray) -> float:
+    """How far (mm) two groups have moved apart: the change in the distance between
+    their centres.  On a moment-loaded DCB (one group per arm) it is the load-line
+    opening the seed paper plots the moment against (Figs 8A, 9A)."""
+    now = group_centre(a, positions) - group_centre(b, positions)
+    then = group_centre(a, initial) - group_centre(b, initial)
+    return float(np.hypot(now[0], now[1]) - np.hypot(then[0], then[1]))
 
 
 def _cut_by_crack(a: np.ndarray, b: np.ndarray, cracks) -> bool:

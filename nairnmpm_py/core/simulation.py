@@ -19,7 +19,7 @@ from ..errors import SimulationUnstable
 from .conditions import GRID_VELOCITY, ConditionRecord, Conditions, evaluate_expression
 from .grid import Grid
 from .kernel_build import load_kernels, material_table
-from .load_couples import couple_moment, load_couples
+from .load_couples import couple_moment, couples_opening, load_couples
 from .particles import Particles
 from .shape import LINEAR, UGIMP
 
@@ -138,6 +138,9 @@ class Simulation:
         for couple in self.couples:
             row[f"moment_Nmm_{couple.name}"] = couple_moment(couple, cond.records,
                                                              self.rec_force, p.pos)
+        if len(self.couples) == 2:
+            a, b = self.couples
+            row[f"opening_mm_{a.name}_{b.name}"] = couples_opening(a, b, p.pos, p.pos0)
         for q in self.global_quantities:
             sel = slice(None) if q.material < 0 else (p.mat == q.material)
             m = p.mass[sel]

@@ -416,6 +416,27 @@ class CrackScene:
         self.grid_current = False
         return True
 
+    def rcurve_theory(self, sim, points: int = 121) -> list[dict]:
+        """For each growing tip whose new crack particles get a traction law: R against
+        the opening at the notch root by seed Eq 16 (Eq 22 for the cubic law), the law
+        unloading linearly to the origin, from 0 to 1.2 delta_c.  It goes into run.json
+        so that ``nairnmpm plot`` can draw it dashed beside the simulated R."""
+        from ..analysis.rcurve import R_of_delta
+        out = []
+        for tip in self.tips:
+            if tip.criterion is None or tip.new_law not in self.laws or tip.material < 0:
+                continue
+            law = self.laws[tip.new_law]
+            jc = tip.criterion.critical_J(sim.materials[tip.material])
+            if not math.isfinite(jc):
+                continue
+            delta = np.linspace(0.0, 1.2 * law.delta_c(1), points)
+            out.append({"crack": tip.crack + 1, "tip": tip.end, "J_tip_c_J_m2": jc,
+                        "J_B_J_m2": float(law.area(1)), "delta_c_mm": float(law.delta_c(1)),
+                        "cod_mm": delta.tolist(),
+                        "R_J_m2": np.asarray(R_of_delta(law, delta, jc), dtype=float).tolist()})
+        return out
+
     def summary(self) -> dict:
         """Crack counters for run.json."""
         cs = self.cracks

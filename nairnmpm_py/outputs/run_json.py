@@ -54,6 +54,11 @@ class RunJson(OutputPlugin):
             "compile_seconds": None,
             "exit_status": "running",
         }
+        scene = getattr(sim, "cracks", None)
+        if scene is not None:
+            theory = scene.rcurve_theory(sim)
+            if theory:
+                self.info["r_curve_theory"] = theory
         self._write(sim)
 
     def end(self, sim, status: dict) -> None:
