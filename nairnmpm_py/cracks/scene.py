@@ -59,6 +59,9 @@ class CrackScene:
         nc = cs.plane.shape[1]
         self.state = np.where(cs.law >= 0, ACTIVE, INTACT).astype(np.int8)
         self.hist = np.zeros((2, nc))
+        # largest opening seen at each particle's edges (halfway to the previous and
+        # the next particle), where a notch root sits (``root_edge``)
+        self.edge_hist = np.zeros((2, nc))
         self.pid = np.arange(nc)          # identity of each crack particle (kept on growth)
         self.counts = np.zeros(4, dtype=np.int64)
         self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
@@ -184,16 +187,16 @@ class CrackScene:
         run = walk[start:start + (int(ends[0]) if ends.size else walk.size - start)]
         return run.tolist(), int(run[-1])
 
-    def traction_work(self, k: int, dn: float | None = None) -> float:
-        """W_B (J/m^2) done by the tractions of crack particle k so far; ``dn`` puts
-        another opening on k's law and history (the root's edge, ``root_edge``)."""
+    def traction_work(self, k: int, dn: float | None = None, h: float | None = None) -> float:
+        """W_B (J/m^2) done by the tractions of crack particle k so far; ``dn`` and ``h``
+        put another opening and largest opening on k's law (its edge, ``root_edge``)."""
         law_index = int(self.cracks.law[k])
         if law_index < 0 or law_index not in self.laws:
             return 0.0
         law = self.laws[law_index]
         if dn is None:
             dn = self.cod_at(k)[0]
-        h = max(self.hist[0, k], dn)
+        h = max(self.hist[0, k] if h is None else h, dn)
         if self.state[k] == FAILED or h >= law.delta_c(1):
             return float(law.area(1))
         if dn >= h:
@@ -203,7 +206,7 @@ class CrackScene:
         s_h = float(law.envelope(h, 1))
         return float(law.work_to(h, 1)) - 0.5 * s_h * h * 1000.0 * (1.0 - (max(dn, 0.0) / h) ** 2)
 
-    def recoverable_work(self, k: int, dn: float | None = None) -> float:
+    def recoverable_work(self, k: int, dn: float | None = None, h: float | None = None) -> float:
         """W_B^(r) (J/m^2): what linear unloading from the current state gives back."""
         law_index = int(self.cracks.law[k])
         if law_index < 0 or law_index not in self.laws or self.state[k] != ACTIVE:
@@ -211,26 +214,52 @@ class CrackScene:
         law = self.laws[law_index]
         if dn is None:
             dn = self.cod_at(k)[0]
-        h = max(self.hist[0, k], dn)
+        h = max(self.hist[0, k] if h is None else h, dn)
         if h <= 0.0 or h >= law.delta_c(1):
             return 0.0
         s_h = float(law.envelope(h, 1))
         d = min(max(dn, 0.0), h)
         return 0.5 * s_h / h * d * d * 1000.0
 
-    def root_edge(self, tip: Tip, k: int) -> tuple[np.ndarray, float]:
-        """(point, normal opening) where the traction zone ends behind crack particle k:
-        a law particle's force acts over half of each segment beside it, so the zone
-        reaches halfway to the next particle away from the tip, and the opening there
-        is the mean of the two.  A particle without a law, or the last one of its
-        crack, stands for itself."""
+    def root_edge(self, tip: Tip, k: int) -> tuple[np.ndarray, float, float]:
+        """(point, normal opening, largest opening so far) where the traction zone ends
+        behind crack particle k: a law particle's force acts over half of each segment
+        beside it, so the zone reaches halfway to the next particle away from the tip,
+        and the opening there is the mean of the two.  A particle without a law, or the
+        last one of its crack, stands for itself."""
         cs = self.cracks
         c = cs.crack[k]
-        nxt = k - 1 if tip.end == "end" else k + 1
+        side = 0 if tip.end == "end" else 1
+        nxt = k - 1 if side == 0 else k + 1
         if int(cs.law[k]) < 0 or not cs.first[c] <= nxt < cs.first[c] + cs.count[c]:
-            return cs.plane[:, k].copy(), self.cod_at(k)[0]
+            return cs.plane[:, k].copy(), self.cod_at(k)[0], float(self.hist[0, k])
         return (0.5 * (cs.plane[:, k] + cs.plane[:, nxt]),
-                0.5 * (self.cod_at(k)[0] + self.cod_at(nxt)[0]))
+                0.5 * (self.cod_at(k)[0] + self.cod_at(nxt)[0]), float(self.edge_hist[side, k]))
+
+    def normal_openings(self) -> np.ndarray:
+        """Normal opening (mm) of every crack particle (``cod_at`` for all at once)."""
+        cs = self.cracks
+        k = np.arange(cs.plane.shape[1])
+        first = cs.first[cs.crack]
+        last = first + cs.count[cs.crack] - 1
+        t = cs.plane[:, np.minimum(k + 1, last)] - cs.plane[:, np.maximum(k - 1, first)]
+        t = t / np.hypot(t[0], t[1])
+        d = cs.above - cs.below
+        return -t[1] * d[0] + t[0] * d[1]
+
+    def update_edge_history(self) -> None:
+        """Raise each particle's edge maxima to the edges' current openings (called at
+        every J evaluation: every propagation check while tips grow, else every
+        archive)."""
+        cs = self.cracks
+        dn = self.normal_openings()
+        k = np.arange(dn.size)
+        first = cs.first[cs.crack]
+        last = first + cs.count[cs.crack] - 1
+        prev_edge = 0.5 * (dn + dn[np.maximum(k - 1, first)])
+        next_edge = 0.5 * (dn + dn[np.minimum(k + 1, last)])
+        np.maximum(self.edge_hist[0], prev_edge, out=self.edge_hist[0])
+        np.maximum(self.edge_hist[1], next_edge, out=self.edge_hist[1])
 
     def cod_at(self, k: int) -> tuple[float, float]:
         """(normal, tangential) opening (mm) at crack particle k."""
@@ -251,6 +280,7 @@ class CrackScene:
         sizes = list(sizes or [self.jcontour_size])
         if not tips:
             return []
+        self.update_edge_history()
         with warnings.catch_warnings():
             # nodes or particles on a crack line: counted, reported in run.json
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -297,9 +327,9 @@ class CrackScene:
         key = (tip.crack, tip.end)
         xt = self._tip_point(tip)
         zone, root = self.zone(tip)
-        root_xy, cod_root = self.root_edge(tip, root)
-        w_root = self.traction_work(root, cod_root) if zone else 0.0
-        w_rec = self.recoverable_work(root, cod_root) if zone else 0.0
+        root_xy, cod_root, h_root = self.root_edge(tip, root)
+        w_root = self.traction_work(root, cod_root, h_root) if zone else 0.0
+        w_rec = self.recoverable_work(root, cod_root, h_root) if zone else 0.0
         row = {"time_ms": sim.time, "crack": tip.crack + 1, "tip": tip.end,
                "contour_cells": size,
                "tip_x_mm": float(xt[0]), "tip_y_mm": float(xt[1]),
@@ -406,6 +436,7 @@ class CrackScene:
         self.state = np.ascontiguousarray(
             np.insert(self.state, at, ACTIVE if tip.new_law >= 0 else INTACT)).astype(np.int8)
         self.hist = np.ascontiguousarray(np.insert(self.hist, [at], 0.0, axis=1))
+        self.edge_hist = np.insert(self.edge_hist, [at], 0.0, axis=1)
         self.pid = np.insert(self.pid, at, self.pid.max() + 1)
         if tip.grown == 1 and tip.new_law >= 0:
             # the notch root of the paper is where the bridging zone starts: the first
