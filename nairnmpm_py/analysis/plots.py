@@ -138,9 +138,11 @@ def _plot_loads(g: dict, columns: list[str], out: Path, written: list[Path]) -> 
         axes[0].set_xlabel(TIME_LABEL)
         axes[0].set_ylabel(LOAD_PREFIXES[prefix])
         if disp is not None:
-            axes[1].plot(disp, load)
+            # a moment against its arms' opening is drawn as a magnitude (Figs 8A, 9A)
+            magnitude = disp_col.startswith(OPENING_PREFIX)
+            axes[1].plot(disp, np.abs(load) if magnitude else load)
             axes[1].set_xlabel(disp_label)
-            axes[1].set_ylabel(LOAD_PREFIXES[prefix])
+            axes[1].set_ylabel("|moment| (N mm)" if magnitude else LOAD_PREFIXES[prefix])
         for ax in axes:
             ax.grid(alpha=0.3)
         fig.suptitle(f"boundary condition {bc}")
@@ -232,8 +234,11 @@ def _plot_cracks(c: dict, out: Path, written: list[Path], run: dict | None = Non
         for label, rows in series:
             ok = rows[np.isfinite(c["R_J_m2"][rows])]
             ax.plot(c["cod_notch0_mm"][ok], c["R_J_m2"][ok], ".-", label=f"R, {label}")
-        for label, d, R in theory_lines(run or {}):
+        theory = theory_lines(run or {})
+        for label, d, R in theory:
             ax.plot(d, R, "k--", lw=1, label=f"theory (Eq 16/22), {label}")
+        if theory:   # the rise is below delta_c (theory runs to 1.2 delta_c)
+            ax.set_xlim(0.0, 1.25 * max(float(d[-1]) for _, d, _ in theory))
         ax.set_xlabel("COD at the original notch root (mm)")
         ax.set_ylabel("R (J/m^2)")
         ax.legend(fontsize="small")

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .plots import (ENERGY_COLUMNS, LOAD_PREFIXES, TIME_LABEL, _figure, _nonzero, _safe,
-                    _save, load_displacement, theory_lines)
+from .plots import (ENERGY_COLUMNS, LOAD_PREFIXES, OPENING_PREFIX, TIME_LABEL, _figure,
+                    _nonzero, _safe, _save, load_displacement, theory_lines)
 from .results import read_csv_columns
 
 SUMMARY = "summary.csv"
@@ -84,11 +84,14 @@ def plot_sweep(folder, out_folder=None) -> list[Path]:
         disps = [load_displacement(g, col) for _, g in have]
         labels = {label for _, label, _ in disps}
         vs_disp = all(d is not None for d, _, _ in disps) and len(labels) == 1
+        # a moment against the opening of its arms is drawn as a magnitude (Figs 8A, 9A)
+        magnitude = vs_disp and all(used.startswith(OPENING_PREFIX) for _, _, used in disps)
         fig, (ax,) = _figure()
         for (name, g), (disp, _, _) in zip(have, disps):
-            ax.plot(disp if vs_disp else g["time_ms"], g[col], label=name)
+            y = np.abs(g[col]) if magnitude else g[col]
+            ax.plot(disp if vs_disp else g["time_ms"], y, label=name)
         ax.set_xlabel(labels.pop() if vs_disp else TIME_LABEL)
-        ax.set_ylabel(LOAD_PREFIXES[prefix])
+        ax.set_ylabel(("|moment| (N mm)" if magnitude else LOAD_PREFIXES[prefix]))
         ax.set_title(f"boundary condition {bc}")
         ax.legend(fontsize="small")
         ax.grid(alpha=0.3)
@@ -165,9 +168,10 @@ def _growth_overlay(lines: list, xlabel: str, ylabel: str, path: Path,
         if name in dashed:
             ax.plot(*dashed[name], "--", lw=1, color=line.get_color())
     if dashed:
+        # the rise is below delta_c (theory runs to 1.2 delta_c; the notch root opens
+        # much further once broken)
         ax.plot([], [], "k--", lw=1, label="theory (Eq 16/22)")
-        right = max(float(np.nanmax(x)) for _, x, _ in lines if len(x))
-        ax.set_xlim(0.0, right * 1.02)
+        ax.set_xlim(0.0, 1.25 * max(float(np.max(x)) for x, _ in dashed.values()))
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.legend(fontsize="small")
