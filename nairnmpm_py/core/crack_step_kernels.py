@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, face_node, _stress_update, _store_weights  # KERNEL-BASE
+from nairnmpm_py.core.step_kernels import KIND, NA, FAST, USF, USL, STATUS_OK, STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY, bc_active, bc_value, node_x, node_y, particle_rotation, face_node, _stress_update, _stress_updates, _store_weights  # KERNEL-BASE
 from nairnmpm_py.traction.dispatch_default import traction_envelope  # KERNEL-TRACTION
 from nairnmpm_py.cracks.crossing import segment_crossing_side
 from nairnmpm_py.cracks.chords import _chord, _chord_cells
@@ -531,12 +531,8 @@ def stress_force(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress, 
                         L01 += vx * gy
                         L10 += vy * gx
                         L11 += vy * gy
-                if dt_pre > 0.0:
-                    _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
-                                   mat_params, plane_stress)
-                if dt_stress > 0.0:
-                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
-                                   mat_params, plane_stress)
+                _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, F, stress, hist, w,
+                                mat, mat_params, plane_stress)
             if not scatter:
                 continue
             vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]

@@ -197,9 +197,9 @@ def _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_val
 
 
 @njit(cache=True, inline="always")
-def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
-                   plane_stress):
-    # F_new = exp(L dt) F_old: exact for rigid rotations, so no spurious volume change
+def _increment_exp(L00, L01, L10, L11, dt):
+    """exp(L dt) of a 2x2 velocity gradient: exact for rigid rotations, so no spurious
+    volume change."""
     a = L00 * dt
     b = L01 * dt
     c = L10 * dt
@@ -224,10 +224,11 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
         e = 1.0 + half * (1.0 + half * (0.5 + half * (1.0 / 6.0 + half * (1.0 / 24.0 + half * (1.0 / 120.0)))))
     else:
         e = math.exp(half)
-    e00 = e * (ch + sh * (a - half))
-    e01 = e * sh * b
-    e10 = e * sh * c
-    e11 = e * (ch + sh * (d - half))
+    return e * (ch + sh * (a - half)), e * sh * b, e * sh * c, e * (ch + sh * (d - half))
+
+
+@njit(cache=True, inline="always")
+def _apply_increment(p, e00, e01, e10, e11, F):
     f00 = F[0, p]
     f01 = F[1, p]
     f10 = F[2, p]
@@ -236,9 +237,41 @@ def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_param
     F[1, p] = e00 * f01 + e01 * f11
     F[2, p] = e10 * f00 + e11 * f10
     F[3, p] = e10 * f01 + e11 * f11
+
+
+@njit(cache=True, inline="always")
+def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
+                   plane_stress):
+    e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt)
+    _apply_increment(p, e00, e01, e10, e11, F)
     m = mat[p]
     material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
                     plane_stress)
+
+
+@njit(cache=True, inline="always")
+def _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
+                    mat_params, plane_stress):
+    """The stress updates of one particle's stress pass with one velocity gradient: a
+    carried-over USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either
+    may be 0).  USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is
+    found once and applied twice (the same numbers as two separate updates)."""
+    if dt_pre == dt_stress and dt_pre > 0.0:
+        e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_pre)
+        m = mat[p]
+        _apply_increment(p, e00, e01, e10, e11, F)
+        material_update(m, p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
+                        plane_stress)
+        _apply_increment(p, e00, e01, e10, e11, F)
+        material_update(m, p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
+                        plane_stress)
+        return
+    if dt_pre > 0.0:
+        _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
+                       plane_stress)
+    if dt_stress > 0.0:
+        _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
+                       plane_stress)
 
 
 @njit(cache=True, error_model="numpy")
@@ -419,12 +452,8 @@ def _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params, plane_
                         L01 += gv[0, k] * gy
                         L10 += gv[1, k] * gx
                         L11 += gv[1, k] * gy
-                if dt_pre > 0.0:
-                    _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat,
-                                   mat_params, plane_stress)
-                if dt_stress > 0.0:
-                    _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
-                                   mat_params, plane_stress)
+                _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, F, stress, hist, w,
+                                mat, mat_params, plane_stress)
             if not scatter:
                 continue
             vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
