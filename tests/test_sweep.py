@@ -154,3 +154,25 @@ def test_moments_plot_against_the_opening_of_their_groups():
         assert used == "opening_mm_bc1_bc2_bc3_bc4" and label == "load-line opening (mm)"
     assert load_displacement(g, "moment_Nmm_bc5_bc6")[0] is None
     assert load_displacement(g, "load_N_bc7_y")[2] == "disp_mm_bc7_y"
+
+
+@pytest.mark.parametrize("table", ["dcb_family.csv", "dcb_family_paper.csv"])
+def test_shipped_dcb_family_tables_make_valid_members(table, tmp_path):
+    """Every member of the shipped family tables (1 mm cells, and the paper's 0.25 mm
+    particles) is a valid input: the template's entities, a grid that holds the
+    specimen, the loaded rows on particle centres."""
+    from pathlib import Path
+
+    from nairnmpm_py.input import load_simulation
+    inputs = Path(__file__).resolve().parents[1] / "inputs"
+    template = inputs / "dcb_bridging.xml"
+    rows = read_table(inputs / table)
+    assert len(rows) == 8
+    for row in rows[:1] + rows[-1:]:
+        path = write(tmp_path, member_input(template.read_text(), row, template), "member.xml")
+        sim = load_simulation(path)
+        spacing = float(row.get("cs", "1")) / 2
+        assert sim.particles.n == round(150 * 12 / spacing ** 2)
+        # four loaded rows, x and y: each the particles within 2 mm of the end
+        members = [rec.n_members for rec in sim.conditions.records if rec.n_members]
+        assert members == [round(2 / spacing)] * 8
