@@ -23,6 +23,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from .geometry import EXTERIOR_END, CrackSet
 from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_intensity,
@@ -31,6 +32,29 @@ from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_i
 INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
 NO_MODE = -1.0
 WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J window
+
+
+@njit(cache=True)
+def _raise_edge_maxima(plane, above, below, crack, first, count, edge_hist):
+    """edge_hist[0, k] / [1, k]: the largest mean normal opening of particle k and its
+    previous / next neighbour so far (the particle itself at a crack's ends).  The
+    normal is that of ``CrackScene.cod_at``: across the chord of the neighbours."""
+    n = plane.shape[1]
+    dn = np.empty(n)
+    for k in range(n):
+        c = crack[k]
+        kp = max(k - 1, first[c])
+        kn = min(k + 1, first[c] + count[c] - 1)
+        tx = plane[0, kn] - plane[0, kp]
+        ty = plane[1, kn] - plane[1, kp]
+        t = math.hypot(tx, ty)
+        dn[k] = (-ty * (above[0, k] - below[0, k]) + tx * (above[1, k] - below[1, k])) / t
+    for k in range(n):
+        c = crack[k]
+        prev_edge = 0.5 * (dn[k] + dn[max(k - 1, first[c])])
+        next_edge = 0.5 * (dn[k] + dn[min(k + 1, first[c] + count[c] - 1)])
+        edge_hist[0, k] = max(edge_hist[0, k], prev_edge)
+        edge_hist[1, k] = max(edge_hist[1, k], next_edge)
 
 
 @dataclass
@@ -236,30 +260,13 @@ class CrackScene:
         return (0.5 * (cs.plane[:, k] + cs.plane[:, nxt]),
                 0.5 * (self.cod_at(k)[0] + self.cod_at(nxt)[0]), float(self.edge_hist[side, k]))
 
-    def normal_openings(self) -> np.ndarray:
-        """Normal opening (mm) of every crack particle (``cod_at`` for all at once)."""
-        cs = self.cracks
-        k = np.arange(cs.plane.shape[1])
-        first = cs.first[cs.crack]
-        last = first + cs.count[cs.crack] - 1
-        t = cs.plane[:, np.minimum(k + 1, last)] - cs.plane[:, np.maximum(k - 1, first)]
-        t = t / np.hypot(t[0], t[1])
-        d = cs.above - cs.below
-        return -t[1] * d[0] + t[0] * d[1]
-
     def update_edge_history(self) -> None:
         """Raise each particle's edge maxima to the edges' current openings (called at
         every J evaluation: every propagation check while tips grow, else every
         archive)."""
         cs = self.cracks
-        dn = self.normal_openings()
-        k = np.arange(dn.size)
-        first = cs.first[cs.crack]
-        last = first + cs.count[cs.crack] - 1
-        prev_edge = 0.5 * (dn + dn[np.maximum(k - 1, first)])
-        next_edge = 0.5 * (dn + dn[np.minimum(k + 1, last)])
-        np.maximum(self.edge_hist[0], prev_edge, out=self.edge_hist[0])
-        np.maximum(self.edge_hist[1], next_edge, out=self.edge_hist[1])
+        _raise_edge_maxima(cs.plane, cs.above, cs.below, cs.crack.astype(np.int64),
+                           cs.first.astype(np.int64), cs.count.astype(np.int64), self.edge_hist)
 
     def cod_at(self, k: int) -> tuple[float, float]:
         """(normal, tangential) opening (mm) at crack particle k."""
