@@ -10,11 +10,12 @@ uncracked beam with two end forces it is the couple they make.
 Each load condition's total force (``load_N_`` column) is taken to act at the current
 centroid of its particles, and the moment (N mm, counter-clockwise positive) is taken
 about the centroid of the group's shapes.  For a couple (zero net force) the reference
-point does not matter.  When there are exactly two groups, global.csv also gets
-``opening_mm_<group>_<group>``: how far the groups' centres have moved apart (the
-load-line opening of a DCB's arms).  This is exact when the particles of one condition carry equal
+point does not matter.  This is exact when the particles of one condition carry equal
 loads (constant, ``<net/>`` or any load of time alone); a style-6 load that depends on
 the particle (x, y, q) differs between particles only by the spread of those values.
+
+When there are exactly two groups, global.csv also gets ``opening_mm_<group>_<group>``:
+how far the groups' centres have moved apart (the load-line opening of a DCB's arms).
 """
 from __future__ import annotations
 
@@ -71,7 +72,7 @@ def couple_moment(couple: LoadCouple, records, rec_force: np.ndarray,
                   positions: np.ndarray) -> float:
     """Moment (N mm, counter-clockwise) of a group's loads about its centroid."""
     at = np.array([positions[:, m].mean(axis=1) for m in couple.members])
-    c = at.mean(axis=0)   # = group_centre
+    c = at.mean(axis=0)   # the group's centre, as group_centre
     moment = 0.0
     for k, r in enumerate(couple.records):
         f = float(rec_force[r])

@@ -11,7 +11,9 @@ Layout::
 
     /archives/NNNNNN/cracks   in scenes with cracks: plane above below (2, nc) mm,
                        crack law traction_state (nc,), traction_history (2, nc) mm
-                       (maximum normal and tangential opening reached)
+                       (maximum normal and tangential opening reached), edge_history
+                       (2, nc) mm (maximum normal opening halfway to the previous and
+                       the next particle, where a notch root is taken)
 
 lp, hist and pdamp are not needed for plotting but are stored so an archive holds the
 whole particle state (enough to restart).
@@ -86,6 +88,7 @@ class ArchiveH5(OutputPlugin):
             cg.create_dataset("law", data=np.asarray(cs.law, dtype=np.int32))
             cg.create_dataset("traction_state", data=np.asarray(scene.state, dtype=np.int8))
             cg.create_dataset("traction_history", data=np.asarray(scene.hist, dtype=np.float64))
+            cg.create_dataset("edge_history", data=np.asarray(scene.edge_hist, dtype=np.float64))
         # after a flush the file on disk is consistent, so a killed run stays readable
         self._h5.flush()
 
