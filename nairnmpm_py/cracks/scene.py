@@ -35,12 +35,12 @@ WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J win
 
 
 @njit(cache=True)
-def _raise_edge_maxima(plane, above, below, crack, first, count, edge_hist):
-    """edge_hist[0, k] / [1, k]: the largest mean normal opening of particle k and its
-    previous / next neighbour so far (the particle itself at a crack's ends).  The
-    normal is that of ``CrackScene.cod_at``: across the chord of the neighbours."""
+def _raise_edge_maxima(plane, above, below, crack, first, count, edge_hist, dn):
+    """dn[k]: the normal opening of particle k now; edge_hist[0, k] / [1, k]: the largest
+    mean normal opening of particle k and its previous / next neighbour so far (the
+    particle itself at a crack's ends).  The normal is that of ``CrackScene.cod_at``:
+    across the chord of the neighbours."""
     n = plane.shape[1]
-    dn = np.empty(n)
     for k in range(n):
         c = crack[k]
         kp = max(k - 1, first[c])
@@ -86,6 +86,7 @@ class CrackScene:
         # largest opening seen at each particle's edges (halfway to the previous and
         # the next particle), where a notch root sits (``root_edge``)
         self.edge_hist = np.zeros((2, nc))
+        self.openings = np.zeros(nc)      # normal openings at the last J evaluation
         self.pid = np.arange(nc)          # identity of each crack particle (kept on growth)
         self.counts = np.zeros(4, dtype=np.int64)
         self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
@@ -250,23 +251,27 @@ class CrackScene:
         behind crack particle k: a law particle's force acts over half of each segment
         beside it, so the zone reaches halfway to the next particle away from the tip,
         and the opening there is the mean of the two.  A particle without a law, or the
-        last one of its crack, stands for itself."""
+        last one of its crack, stands for itself.  Uses the openings of the last
+        ``update_edge_history`` (the start of every J evaluation)."""
         cs = self.cracks
         c = cs.crack[k]
+        dn = self.openings
         side = 0 if tip.end == "end" else 1
         nxt = k - 1 if side == 0 else k + 1
         if int(cs.law[k]) < 0 or not cs.first[c] <= nxt < cs.first[c] + cs.count[c]:
-            return cs.plane[:, k].copy(), self.cod_at(k)[0], float(self.hist[0, k])
-        return (0.5 * (cs.plane[:, k] + cs.plane[:, nxt]),
-                0.5 * (self.cod_at(k)[0] + self.cod_at(nxt)[0]), float(self.edge_hist[side, k]))
+            return cs.plane[:, k].copy(), float(dn[k]), float(self.hist[0, k])
+        return (0.5 * (cs.plane[:, k] + cs.plane[:, nxt]), float(0.5 * (dn[k] + dn[nxt])),
+                float(self.edge_hist[side, k]))
 
     def update_edge_history(self) -> None:
         """Raise each particle's edge maxima to the edges' current openings (called at
         every J evaluation: every propagation check while tips grow, else every
         archive)."""
         cs = self.cracks
+        self.openings = np.empty(cs.plane.shape[1])
         _raise_edge_maxima(cs.plane, cs.above, cs.below, cs.crack.astype(np.int64),
-                           cs.first.astype(np.int64), cs.count.astype(np.int64), self.edge_hist)
+                           cs.first.astype(np.int64), cs.count.astype(np.int64), self.edge_hist,
+                           self.openings)
 
     def cod_at(self, k: int) -> tuple[float, float]:
         """(normal, tangential) opening (mm) at crack particle k."""
