@@ -16,11 +16,12 @@ second, and the crack's overhead in percent of the uncracked step.
 from __future__ import annotations
 
 import argparse
-import csv
 import time
 from pathlib import Path
 
 import numba
+
+from csv_rows import write_rows
 
 HERE = Path(__file__).resolve().parent
 CRACK = """  <CrackList>
@@ -76,10 +77,7 @@ def main() -> None:
                          "M_updates_per_s": round(30000 / t / 1e6, 3),
                          "overhead_pct": round(100 * (t / base - 1), 1)})
             print(rows[-1], flush=True)
-    with open(out / "crack_cost.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "crack_cost.csv", rows)
 
 
 if __name__ == "__main__":

@@ -23,12 +23,13 @@ of the same scene first) and need an idle machine.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import time
 from pathlib import Path
 
 import numpy as np
+
+from csv_rows import write_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "inputs" / "dcb_bridging.xml"
@@ -139,10 +140,7 @@ def main() -> None:
                    **measures(case["folder"])}
             rows.append(row)
             print(row, flush=True)
-    with open(out / "dcb_cost.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "dcb_cost.csv", rows)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

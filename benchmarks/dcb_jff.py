@@ -15,10 +15,11 @@ theory against time, and the 1-ms means) to --out.  About 5 minutes at 0.25 mm
 from __future__ import annotations
 
 import argparse
-import csv
 from pathlib import Path
 
 import numpy as np
+
+from csv_rows import write_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 E, H, B = 2500.0, 6.0, 1.0          # MPa, mm (arm depth), mm (thickness)
@@ -96,10 +97,7 @@ def main() -> None:
         print(f"{spacing:g} mm particles: " + " ".join(f"{x:.3f}" for x in ratios), flush=True)
         rows += [{"spacing_mm": spacing, "cell_mm": 2 * spacing, "window_ms": f"{k + 1}-{k + 2}",
                   "J_ff_over_beam_theory": round(x, 4)} for k, x in enumerate(ratios)]
-    with open(out / "dcb_jff.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(out / "dcb_jff.csv", rows)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

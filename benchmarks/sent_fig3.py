@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numba
 
+from csv_rows import write_rows
+
 HERE = Path(__file__).resolve().parent
 INPUTS = HERE.parent / "inputs"
 J0 = 354.88
@@ -148,10 +150,7 @@ def main() -> None:
             w.writerow({**r, "J_x_over_J0": r["J_x"] / J0, "J_tip_over_J0": r["J_tip"] / J0,
                         "J_ff_over_J0": r["J_ff"] / J0})
     summary = checks(rows)
-    with open(out / f"{stem}_checks.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(summary[0]))
-        w.writeheader()
-        w.writerows(summary)
+    write_rows(out / f"{stem}_checks.csv", summary)
     for r in summary:
         print("  ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
                         for k, v in r.items()))
