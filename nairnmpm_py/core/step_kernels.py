@@ -17,17 +17,23 @@ cracks builds this file with ``MULTI_FIELD`` True and the crack module's
 (``K.vfld``; ``K.cut`` 0 for a particle that touches no crack node); every pass here
 then reads and writes the particle's own field.
 
+Every task and chunk function is compiled without a Python entry point
+(``no_cpython_wrapper``): only the driver calls them, and the unboxing code of five
+bundles would cost about a second of compiling each.
+
 Particle loops run as fixed chunks, each with its own grid buffer, reduced in a fixed
 order: results do not depend on thread scheduling.  A parallel task's ``prange`` body
-only calls the chunk's function with the bundles: Numba 0.68 loses writes made
-through a bundle's arrays inside a ``prange`` body itself (measured), not through
-those of a function it calls.  ``FAST`` allows reassociation and
+only calls the chunk's function with the bundles and an int64 chunk index: Numba 0.68
+loses writes made through a bundle's arrays inside a ``prange`` body itself
+(measured), not through those of a function it calls, and the index would otherwise
+arrive as uint64 in one compile and int64 in another (two compiles of each chunk).  ``FAST`` allows reassociation and
 fused multiply-adds but keeps NaN and infinity semantics, so blow-ups are still caught.
 """
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from nairnmpm_py.core.grid_ops import accelerate_node
@@ -141,7 +147,7 @@ def face_node(pos, lp, F, geom, nny, p, face, m):
     return i + a, j + b, 0.5 * (fx if a == 1 else 1.0 - fx) * (fy if b == 1 else 1.0 - fy)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def scatter_loads(P, G, C, K, S):
     """Clear the grid forces, then the particle loads (N) at this time onto the grid,
     in the field the particle uses at each node; ``C.pload`` keeps them for the work,
@@ -182,7 +188,7 @@ def scatter_loads(P, G, C, K, S):
                 g[field_at(K, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def load_work(P, G, C, K, S):
     """Work (mJ) of each particle load over the step just taken."""
     for q in range(C.pbc_part.size):
@@ -191,7 +197,7 @@ def load_work(P, G, C, K, S):
 
 
 # ---- velocity conditions ---------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def momentum_conditions(P, G, C, K, S):
     """Impose velocity conditions on the extrapolated momenta of every field, then
     the velocities of the conditioned nodes.
@@ -238,7 +244,7 @@ def momentum_conditions(P, G, C, K, S):
                     gv[f, 1, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def velocity_conditions(P, G, C, K, S):
     """Impose v(t+dt) on conditioned nodes in every field; the force that takes is
     the reaction (summed over the fields)."""
@@ -338,35 +344,26 @@ def _apply_increment(p, e00, e01, e10, e11, F):
 
 
 @njit(cache=True, inline="always")
-def _stress_update(P, S, p, dt, L00, L01, L10, L11):
-    e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt)
-    _apply_increment(p, e00, e01, e10, e11, P.F)
-    m = P.mat[p]
-    material_update(m, p, dt, L00, L01, L10, L11, P.F, P.stress, P.hist, P.w, S.mat_params[m],
-                    S.plane_stress)
-
-
-@njit(cache=True, inline="always")
 def _stress_updates(P, S, p, dt_pre, dt_stress, L00, L01, L10, L11):
-    """The stress updates of one particle's stress pass with one velocity gradient: a
-    carried-over USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either
-    may be 0).  USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is
-    found once and applied twice (the same numbers as two separate updates)."""
-    if dt_pre == dt_stress and dt_pre > 0.0:
-        e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_pre)
-        m = P.mat[p]
-        for _ in range(2):
-            _apply_increment(p, e00, e01, e10, e11, P.F)
-            material_update(m, p, dt_pre, L00, L01, L10, L11, P.F, P.stress, P.hist, P.w,
-                            S.mat_params[m], S.plane_stress)
-        return
-    if dt_pre > 0.0:
-        _stress_update(P, S, p, dt_pre, L00, L01, L10, L11)
-    if dt_stress > 0.0:
-        _stress_update(P, S, p, dt_stress, L00, L01, L10, L11)
+    """The stress updates of one particle with one velocity gradient: a carried-over
+    USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either may be 0).
+    USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is found once
+    and applied twice (the same numbers as two separate updates).  One call site of
+    the material update, so its inlined code exists once per pass."""
+    e00 = e01 = e10 = e11 = 0.0
+    m = P.mat[p]
+    for i in range(2):
+        dt_i = dt_pre if i == 0 else dt_stress
+        if dt_i <= 0.0:
+            continue
+        if i == 0 or dt_pre != dt_stress:
+            e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_i)
+        _apply_increment(p, e00, e01, e10, e11, P.F)
+        material_update(m, p, dt_i, L00, L01, L10, L11, P.F, P.stress, P.hist, P.w,
+                        S.mat_params[m], S.plane_stress)
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def _stress_chunk(P, G, K, S, c, dt_pre, dt_stress, scatter):
     """Chunk c of the stress pass: each particle's velocity gradient from its own
     fields' grid velocities, its stress updates (``_stress_updates``), and with
@@ -426,33 +423,34 @@ def _stress_chunk(P, G, K, S, c, dt_pre, dt_stress, scatter):
                 buf[f, GFY, k] -= sxy * gx + syy * gy
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
 def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
     for c in prange(S.nch):
-        _stress_chunk(P, G, K, S, c, dt_pre, dt_stress, scatter)
+        _stress_chunk(P, G, K, S, np.int64(c), dt_pre, dt_stress, scatter)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def stress_and_forces(P, G, C, K, S):
     """Stress update (USF / USAVG first half, plus a carried-over USAVG+ / USL+ last
     half) fused with the internal forces into the chunk buffers."""
     pending = S.clock[CLOCK_PENDING]
     S.clock[CLOCK_PENDING] = 0.0
-    _stress_pass(P, G, K, S, pending, S.dt_first, True)
+    _stress_pass(P, G, K, S, pending, S.dt_first, S.nch > 0)   # a runtime True (see flush)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def flush_stress(P, G, C, K, S):
     """Apply a carried USAVG+ / USL+ stress half now (before stresses or energies are
     read, or when a run stops)."""
     pending = S.clock[CLOCK_PENDING]
     if pending > 0.0:
         S.clock[CLOCK_PENDING] = 0.0
-        _stress_pass(P, G, K, S, 0.0, pending, False)
+        # a runtime False: a literal would make Numba compile the whole pass twice
+        _stress_pass(P, G, K, S, 0.0, pending, S.nch < 0)
 
 
 # ---- grid ------------------------------------------------------------------------------
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def reduce_forces(P, G, C, K, S):
     """Add the chunks' internal forces of field 0 to the grid forces (the loads)."""
     g = G.g
@@ -468,7 +466,7 @@ def reduce_forces(P, G, C, K, S):
         g[0, GFY, k] += fy
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def accelerate(P, G, C, K, S):
     """Field 0's accelerations and updated velocities on every node."""
     dt = S.dt
@@ -480,7 +478,7 @@ def accelerate(P, G, C, K, S):
         accelerate_node(g, ga, gvn, 0, k, dt, mass_tol)
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def reduce_extrapolation(P, G, C, K, S):
     """Sum the chunks' mass and momentum of field 0 and its velocities (before
     conditions)."""
@@ -561,7 +559,7 @@ def _scatter_particle(P, G, K, buf, p, nnx, conflicts):
     return conflicts
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def _weights_chunk(P, G, K, S, c):
     n = P.pos.shape[1]
     nch = S.nch
@@ -581,15 +579,15 @@ def _weights_chunk(P, G, K, S, c):
         K.chunk_counts[c] = conflicts
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
 def weights_and_mass(P, G, C, K, S):
     """Weights of every particle (cached) and their mass and momentum on the grid."""
     for c in prange(S.nch):
-        _weights_chunk(P, G, K, S, c)
+        _weights_chunk(P, G, K, S, np.int64(c))
 
 
 # ---- grid -> particles -----------------------------------------------------------------
-@njit(cache=True, fastmath=FAST, error_model="numpy")
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def _update_chunk(P, G, K, S, c):
     n = P.pos.shape[1]
     nch = S.nch
@@ -668,7 +666,7 @@ def _update_chunk(P, G, K, S, c):
         pos[0, p] = x
         pos[1, p] = y
         if dt_stress > 0.0:
-            _stress_update(P, S, p, dt_stress, L00, L01, L10, L11)
+            _stress_updates(P, S, p, 0.0, dt_stress, L00, L01, L10, L11)
         if bad[c, 0] < 0:
             if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
                     and math.isfinite(y) and math.isfinite(P.stress[0, p])):
@@ -683,18 +681,18 @@ def _update_chunk(P, G, K, S, c):
         K.chunk_counts[c] = conflicts
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
 def update_and_extrapolate(P, G, C, K, S):
     """Grid -> particles (FLIP velocity and position with grid and particle damping,
     as NairnMPM applies them; the USL- / USAVG- stress update), then each particle's
     new weights and its mass and momentum back to the grid (the next extrapolation:
     in every method positions and velocities do not change in between)."""
     for c in prange(S.nch):
-        _update_chunk(P, G, K, S, c)
+        _update_chunk(P, G, K, S, np.int64(c))
 
 
 # ---- bookkeeping -----------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def advance_clock(P, G, C, K, S):
     """The step is taken: the time moves on, and USL+ / USAVG+ carry the last stress
     half into the next stress pass (it has the same velocity gradient)."""
@@ -703,7 +701,7 @@ def advance_clock(P, G, C, K, S):
         S.clock[CLOCK_PENDING] = S.dt_last
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def check_status(P, G, C, K, S):
     """The first chunk's bad particle (NaN or runaway), else too many particles that
     tried to leave the grid, into ``S.status``."""

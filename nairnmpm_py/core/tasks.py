@@ -113,7 +113,9 @@ ARGS = "P, G, C, K, S"
 JIT = "@_njit_driver(cache=True, error_model='numpy')"
 
 
-def _calls(tasks, indent: str, profile: bool, index: dict) -> list[str]:
+def _calls(tasks, indent: str, profile: bool, index: dict, stop: str) -> list[str]:
+    """Calls of ``tasks``; after a task that may stop the run, ``stop`` (a line that
+    leaves the loop) or, with ``stop`` empty, the rest nested under a status test."""
     out = []
     for task in tasks:
         if profile:
@@ -122,8 +124,13 @@ def _calls(tasks, indent: str, profile: bool, index: dict) -> list[str]:
         if profile:
             out.append(f"{indent}prof[{index[task.name]}] += _cycles() - _c0")
         if task.stops:
-            out.append(f"{indent}if S.status[0] != 0:")
-            out.append(f"{indent}    return step + 1")
+            if stop:
+                out += [f"{indent}if S.status[0] != 0:", f"{indent}    {stop}"]
+            else:
+                out.append(f"{indent}if S.status[0] == 0:")
+                indent += "    "
+    if not tasks or (out and out[-1].endswith(":")):
+        out.append(f"{indent}pass")
     return out
 
 
@@ -140,30 +147,27 @@ def profile_rows(with_cracks: bool) -> list[str]:
 def driver_source(with_cracks: bool) -> str:
     """Source of the fused driver for the generated kernel module: ``advance`` (and
     ``advance_profiled``, which also counts each task's clock cycles into ``prof``,
-    indexed as ``profile_rows``).  It expects every task name in its namespace."""
+    indexed as ``profile_rows``).  It expects every task name in its namespace.
+    One function each: Numba links every callee's code into its caller and optimizes
+    it again, so each extra driver level would cost seconds of compiling."""
     extrapolate, step, finish = step_tasks(with_cracks)
     index = {name: i for i, name in enumerate(profile_rows(with_cracks))}
     lines = ["from numba import njit as _njit_driver",
              "from nairnmpm_py.core.cycles import cycles as _cycles"]
     for suffix, profile in (("", False), ("_profiled", True)):
         extra = ", prof" if profile else ""
-        lines += ["", "", JIT, f"def _extrapolate{suffix}({ARGS}{extra}):", "    step = -1"]
-        lines += _calls(extrapolate, "    ", profile, index)
-        lines += ["    return 0", "", "", JIT, f"def _steps{suffix}({ARGS}, nsteps{extra}):",
-                  "    for step in range(nsteps):"]
-        lines += _calls(step, "        ", profile, index)
-        lines += ["    return nsteps", "", "", JIT,
-                  f"def advance{suffix}({ARGS}, nsteps, resume, flush{extra}):",
+        lines += ["", "", JIT, f"def advance{suffix}({ARGS}, nsteps, resume, flush{extra}):",
                   '    """Up to nsteps steps, extrapolating first unless ``resume``; returns the',
                   '    steps taken (S.status says why it stopped early)."""',
                   "    S.status[0] = 0",
                   "    S.status[1] = -1",
                   "    done = 0",
-                  "    if not resume:",
-                  f"        _extrapolate{suffix}({ARGS}{extra})",
-                  "    if S.status[0] == 0:",
-                  f"        done = _steps{suffix}({ARGS}, nsteps{extra})",
-                  "    if S.status[0] != 0 or flush:"]
-        lines += _calls(finish, "        ", profile, index)
+                  "    if not resume:"]
+        lines += _calls(extrapolate, "        ", profile, index, "")
+        lines += ["    for step in range(nsteps if S.status[0] == 0 else 0):",
+                  "        done = step + 1"]
+        lines += _calls(step, "        ", profile, index, "break")
+        lines += ["    if S.status[0] != 0 or flush:"]
+        lines += _calls(finish, "        ", profile, index, "")
         lines += ["    return done"]
     return "\n".join(lines) + "\n"

@@ -108,7 +108,7 @@ def _add_normal(fb, k, w, side, chord, cp):
     fb[GSD, k] += w * side
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True)
 def assign_and_scatter(P, G, K, buf, p, conflicts):
     """Field choice at each node of particle p, then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
@@ -182,7 +182,7 @@ def assign_and_scatter(P, G, K, buf, p, conflicts):
 
 
 # ---- crack nodes ------------------------------------------------------------------------
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def reduce_crack_fields(P, G, C, K, S):
     """Sum the chunks' extrapolated rows at the crack nodes (fields 1-3, and field 0's
     contact rows), zeroing those buffer entries; velocities there.  Adds the chunks'
@@ -214,7 +214,7 @@ def reduce_crack_fields(P, G, C, K, S):
                 gv[f, 1, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def clear_crack_nodes(P, G, C, K, S):
     """Zero fields 1-3 and the contact rows at the previous step's crack nodes (the
     cracks have moved and the crack nodes changed), so away from crack nodes those
@@ -235,7 +235,7 @@ def clear_crack_nodes(P, G, C, K, S):
                     G.gvn[f, d, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def reduce_crack_forces(P, G, C, K, S):
     """Add the chunks' internal forces of fields 1-3 at the crack nodes (zeroing those
     buffer entries)."""
@@ -256,7 +256,7 @@ def reduce_crack_forces(P, G, C, K, S):
             g[f, GFY, k] += fy
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def accelerate_crack_fields(P, G, C, K, S):
     """Accelerations and updated velocities of fields 1-3 at the crack nodes."""
     for q in range(K.nlist[N_CNODES]):
@@ -352,18 +352,19 @@ def contact(g, gv, nslot, cnodes, dt, after_update, use_position, cutoff_cells, 
                     gv[f, 1, k] = g[f, GPY, k] / m
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def contact_momenta(P, G, C, K, S):
     """Contact on the extrapolated momenta (and their velocities)."""
-    contact(G.g, G.gv, K.nslot, K.cnodes[:K.nlist[N_CNODES]], S.dt, False, K.use_position,
-            K.cutoff_cells, G.geom)
+    # after_update as a runtime False / True: literals would compile contact twice
+    contact(G.g, G.gv, K.nslot, K.cnodes[:K.nlist[N_CNODES]], S.dt, S.nch < 0,
+            K.use_position, K.cutoff_cells, G.geom)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def contact_forces(P, G, C, K, S):
     """Contact on the updated momenta, as a change of the forces."""
-    contact(G.g, G.gv, K.nslot, K.cnodes[:K.nlist[N_CNODES]], S.dt, True, K.use_position,
-            K.cutoff_cells, G.geom)
+    contact(G.g, G.gv, K.nslot, K.cnodes[:K.nlist[N_CNODES]], S.dt, S.nch > 0,
+            K.use_position, K.cutoff_cells, G.geom)
 
 
 # ---- crack particles ------------------------------------------------------------------
@@ -393,7 +394,7 @@ def _surface_cell(sx, sy, geom):
     return i0, j0, xi - i0, eta - j0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True)
 def _surface_nodes(sx, sy, ux, uy, sgn, G, K, scratch):
     """Classic linear shape functions at a crack surface point and the field on the
     surface's side at each of the four nodes; weights are S * m of that field (0 when
@@ -444,7 +445,7 @@ def _near_crack_end(k, K, geom):
     return False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True)
 def _mirror_surface_nodes(sx, sy, crack, G, K, scratch):
     """The second surface of a crack particle away from the crack's ends, when it lies
     in the same cell as the first: each node's field is the first surface's with the
@@ -497,7 +498,7 @@ def _side_scratch():
             np.empty(4, dtype=np.int64), np.empty(4, dtype=np.bool_))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True)
 def _side_nodes(k, side, sx, sy, ux, uy, G, K, scratch):
     """Nodes, fields and weights (``scratch[0:3]``) of one surface of crack particle k:
     the second surface (side 1) mirrors the first where it can, else both run the
@@ -515,7 +516,7 @@ def _side_nodes(k, side, sx, sy, ux, uy, G, K, scratch):
     return total
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def crack_tractions(P, G, C, K, S):
     """Traction forces of the law particles on both surfaces' fields (the force is
     shared by S * m, all of it delivered), with history, unloading to the origin and
@@ -579,7 +580,7 @@ def crack_tractions(P, G, C, K, S):
                     g[fields[q], GFY, nodes[q]] += share * fy
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def _moves_chunk(G, K, S, c, moves, found, blocked):
     """Chunk c of the crack particles' surface moves over the step: the mean of the
     old and new velocity of the field on each surface's side (mass-weighted, classic
@@ -623,15 +624,15 @@ def _moves_chunk(G, K, S, c, moves, found, blocked):
             found[k, side] = True
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
 def _surface_moves(G, K, S, moves, found, blocked):
     """Each crack particle's surface moves, found independently in ``S.nch`` chunks
     (so they do not depend on the chunking)."""
     for c in prange(S.nch):
-        _moves_chunk(G, K, S, c, moves, found, blocked)
+        _moves_chunk(G, K, S, np.int64(c), moves, found, blocked)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def move_cracks(P, G, C, K, S):
     """Surfaces move by ``_surface_moves``; a side that finds no field copies the
     other; the plane moves with the mean of the two surfaces.  A crack particle that
@@ -672,7 +673,7 @@ def move_cracks(P, G, C, K, S):
         S.status[1] = out
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def crack_lists(P, G, C, K, S):
     """Rebuild the crack lists for the current planes (``build_crack_lists``); the
     previous crack nodes are kept for ``clear_crack_nodes``."""
