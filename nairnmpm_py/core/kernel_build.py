@@ -91,14 +91,15 @@ def _replace_marked(lines: list[str], marker: str, text: str, where: str) -> Non
 
 def load_kernels(update_functions: list[str], shape: int = 1,
                  expressions: dict[int, str] | None = None,
-                 crack_envelopes: list[str] | None = None, parallel: bool = True):
+                 crack_envelopes: list[str] | None = None):
     """(kernel module, condition constants) for a scene whose materials use these
     update functions (in order), with one kind of shape function (0 linear, 1 uGIMP),
     the scene's style-6 condition expressions (record index -> expression of t) and,
     for a scene with cracks, the traction envelopes of its laws ("module:function",
     index = kind in the law tables).  The module's ``advance`` is the step driver.
-    ``parallel`` False builds the kernels without Numba's parallel loops (a scene run
-    on one thread: the same numbers, and a third less to compile)."""
+    (A build without Numba's parallel loops for one-thread scenes compiles a third
+    faster but ran the beam 2.7x slower on one thread; not used until that is
+    understood.)"""
     lines = Path(step_kernels.__file__).read_text().splitlines()
     where = "step_kernels.py"
     _replace_marked(lines, MARKER, _dispatch_source(update_functions), where)
@@ -112,7 +113,7 @@ def load_kernels(update_functions: list[str], shape: int = 1,
                                "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x"]
     with_cracks = crack_envelopes is not None
     if with_cracks:
-        cracks = _load_crack_tasks(shape, crack_envelopes, parallel)
+        cracks = _load_crack_tasks(shape, crack_envelopes)
         crack_names = sorted({t.name for group in step_tasks(True) for t in group
                               if t.module == CRACKS})
         _replace_marked(lines, FIELDS_MARKER,
@@ -120,14 +121,8 @@ def load_kernels(update_functions: list[str], shape: int = 1,
                         + ", ".join(crack_names), where)
         _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
         refs.append(cracks.__name__ + ":x")
-    source = _serial("\n".join(lines) + "\n\n" + driver_source(with_cracks), parallel)
+    source = "\n".join(lines) + "\n\n" + driver_source(with_cracks)
     return _load_source(source, "nairnmpm_kernels", refs), constants
-
-
-def _serial(source: str, parallel: bool) -> str:
-    """The source with Numba's parallel loops turned into plain ones unless
-    ``parallel`` (``prange`` then runs as ``range``, chunk by chunk)."""
-    return source if parallel else source.replace("parallel=True", "parallel=False")
 
 
 def _dependency_text(refs: list[str]) -> str:
@@ -184,7 +179,7 @@ def _traction_source(functions: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _load_crack_tasks(shape: int, envelope_functions: list[str], parallel: bool):
+def _load_crack_tasks(shape: int, envelope_functions: list[str]):
     """The crack tasks' template (``tasks.CRACKS``) built for this shape function and
     dispatching over these traction envelopes."""
     spec = importlib.util.find_spec(CRACKS)
@@ -193,5 +188,5 @@ def _load_crack_tasks(shape: int, envelope_functions: list[str], parallel: bool)
     _replace_marked(lines, TRACTION_MARKER, _traction_source(envelope_functions), where)
     _replace_marked(lines, SHAPE_MARKER, f"KIND = {int(shape)}  # shape functions of this build",
                     where)
-    source = _serial("\n".join(lines) + "\n", parallel)
+    source = "\n".join(lines) + "\n"
     return _load_source(source, "nairnmpm_crack_kernels", envelope_functions + CRACK_DEPENDENCIES)

@@ -127,8 +127,7 @@ class Simulation:
         expressions = {r: rec.function for r, rec in enumerate(self.conditions.records)
                        if rec.style == 6}
         envelopes = self.cracks.envelope_functions() if self.cracks is not None else None
-        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes,
-                                                 parallel=self.parallel)
+        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
         nf, rows = (self.cracks.nf, self.cracks.n_rows) if self.cracks else (1, N_ROWS)

@@ -108,7 +108,7 @@ def _add_normal(fb, k, w, side, chord, cp):
     fb[GSD, k] += w * side
 
 
-@njit(cache=True, no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def assign_and_scatter(P, G, K, buf, p, conflicts):
     """Field choice at each node of particle p, then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
