@@ -117,7 +117,7 @@ def cmd_run(args) -> int:
     if not args.quiet:
         print(_summary(sim), file=sys.stderr)
     try:
-        status = sim.run(outputs, progress=progress)
+        status = sim.run(outputs, progress=progress, profile=args.profile)
     except SimulationUnstable as exc:
         if bar is not None:
             bar.close()
@@ -133,6 +133,9 @@ def cmd_run(args) -> int:
     if not args.quiet:
         print(f"done: {sim.step} steps in {status['wall_seconds']:.2f} s; results in {out}",
               file=sys.stderr)
+    if status.get("profile"):
+        from .core.profile import format_table
+        print(format_table(status["profile"]))
     return EXIT_OK
 
 
@@ -182,6 +185,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", help="results folder (default: next to FILE, FILE_results)")
     p.add_argument("--force", action="store_true", help="replace an existing results folder")
     p.add_argument("-q", "--quiet", action="store_true", help="no summary or progress bar")
+    p.add_argument("--profile", action="store_true",
+                   help="time each task of the step; table at the end and in run.json")
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("check", help="parse and validate only; print a summary")
     p.add_argument("file")

@@ -1,8 +1,11 @@
-"""Grid-side crack kernels of the engine (``core/crack_step_kernels``, loaded here as
-the plain template): chord lists per cell, the particle-node field choice, contact."""
+"""Grid-side crack kernels of the engine (``cracks/crack_kernels``, loaded here as
+the plain template, and ``cracks/crack_lists``): chord lists per cell, the
+particle-node field choice, contact."""
 import numpy as np
 
-from nairnmpm_py.core import crack_step_kernels as K
+from nairnmpm_py.cracks import crack_kernels as K
+from nairnmpm_py.cracks.bundle import NR
+from nairnmpm_py.cracks.crack_lists import build_crack_lists
 
 GEOM = np.array([-1.0, -1.0, 1.0, 1.0, 12.0])   # node 0 at (-1, -1), 1 mm cells
 NNX = 12
@@ -19,7 +22,7 @@ class Lists:
         self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)
 
     def build(self, c):
-        self.chords, self.cxy, self.cnodes = K.crack_lists(
+        self.chords, self.cxy, self.cnodes = build_crack_lists(
             c["cp"], c["cfirst"], c["clast"], c["cext0"], c["cext1"], c["ccrack"], GEOM, NCX,
             NCY, NNX, self.nslot, self.cstart, self.cnear, self.cbox)
         return self
@@ -39,8 +42,7 @@ def _cell(x, y):
 def _field(c, lists, x, y, nx, ny):
     node = int(round(ny - GEOM[1])) * NNX + int(round(nx - GEOM[0]))
     f, *_ = K._pair_field(x, y, nx, ny, node, _cell(x, y), lists.cstart, lists.chords, lists.cxy,
-                          c["cp"][0], c["cp"][1], c["cfirst"], c["clast"], c["cext0"],
-                          c["cext1"], c["ccrack"], lists.nslot, 2)
+                          c["ccrack"], lists.nslot, 2)
     return f
 
 
@@ -75,7 +77,7 @@ def test_field_is_one_across_the_crack_and_zero_beside_or_beyond_the_tip():
 
 
 def test_contact_stops_approach_without_changing_total_momentum():
-    g = np.zeros((2, K.NR, 1))
+    g = np.zeros((2, NR, 1))
     g[0, K.GM, 0], g[1, K.GM, 0] = 2.0, 1.0                  # masses: 0 above, 1 below
     g[0, K.GPY, 0], g[1, K.GPY, 0] = 2.0 * -1.0, 1.0 * 0.5   # field 0 moves down onto 1
     g[0, K.GUY, 0] = 2.0 * -0.01                             # and already overlaps it

@@ -1,11 +1,16 @@
-"""Build the step kernels of one scene, with its materials' updates inlined.
+"""Build the step kernels of one scene: its materials, shape functions, condition
+expressions and velocity fields filled into the templates, and the driver composed
+from the task list (``core/tasks.py``).
 
 Numba caches a compiled function by its source file, and cannot cache a kernel that
-receives a jitted function as an argument.  So for each set of material update
-functions we write a copy of ``step_kernels.py`` into a cache folder, with the
-default material import replaced by a dispatcher over exactly those updates.  The
-copy is written once per (kernel source, materials) pair; later runs load it and its
-Numba cache, which makes warm starts fast.
+receives a jitted function as an argument.  So for each scene kind we write a copy of
+``step_kernels.py`` into a cache folder, with the default material import replaced by
+a dispatcher over exactly the scene's updates, and append the driver.  A scene with
+cracks also gets a copy of the crack tasks' template (``tasks.CRACKS``) with its
+traction-law envelopes, imported by the step copy.  A copy is written once per
+distinct source; later runs load it and its Numba cache, which makes warm starts
+fast.  Numbers in the condition expressions are runtime constants, so scenes that
+differ only in them share one copy.
 """
 from __future__ import annotations
 
@@ -18,11 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from . import step_kernels
-from .conditions import expression_source
+from .expressions import condition_module_source
+from .tasks import CRACKS, driver_source, step_tasks
 
 MARKER = "# KERNEL-MATERIALS"
 SHAPE_MARKER = "# KERNEL-SHAPE"
 FUNCTIONS_MARKER = "# KERNEL-FUNCTIONS"
+FIELDS_MARKER = "# KERNEL-FIELDS"
+MULTI_FIELD_MARKER = "# KERNEL-MULTI-FIELD"
 
 
 def cache_dir() -> Path:
@@ -73,39 +81,48 @@ def material_table(materials: list, plane_stress: bool) -> tuple[list[str], np.n
     return functions, table
 
 
-def _condition_source(expressions: dict[int, str]) -> str:
-    """``condition_function(r, t, x, y, q)``: the style-6 expression of record r."""
-    lines = ["import math as _math_fn", "from numba import njit as _njit_fn", "", "",
-             "@_njit_fn(cache=True, inline='always')", "def condition_function(r, t, x, y, q):"]
-    for r, text in sorted(expressions.items()):
-        src = expression_source(text).replace("math.", "_math_fn.")
-        lines.append(f"    if r == {int(r)}:")
-        lines.append(f"        return {src}")
-    lines.append("    return 0.0")
-    return "\n".join(lines) + "\n"
+def _replace_marked(lines: list[str], marker: str, text: str, where: str) -> None:
+    """Replace the one line of ``lines`` that carries ``marker``."""
+    hits = [i for i, line in enumerate(lines) if marker in line]
+    if len(hits) != 1:
+        raise RuntimeError(f"{where} must have exactly one '{marker}' line")
+    lines[hits[0]] = text
 
 
 def load_kernels(update_functions: list[str], shape: int = 1,
-                 expressions: dict[int, str] | None = None):
-    """Return the kernel module dispatching over these update functions (in order),
-    compiled for one kind of shape function (0 linear, 1 uGIMP) and with the scene's
-    style-6 condition expressions (record index -> expression of t)."""
-    template = Path(step_kernels.__file__).read_text()
-    lines = template.splitlines()
-    marked = [i for i, line in enumerate(lines) if line.rstrip().endswith(MARKER)]
-    shaped = [i for i, line in enumerate(lines) if SHAPE_MARKER in line]
-    if len(marked) != 1 or len(shaped) != 1:
-        raise RuntimeError("step_kernels.py must have exactly one material import marker "
-                           "and one shape marker")
-    lines[marked[0]] = _dispatch_source(update_functions)
-    lines[shaped[0]] = f"KIND = {int(shape)}  # shape functions of this build"
+                 expressions: dict[int, str] | None = None,
+                 crack_envelopes: list[str] | None = None):
+    """(kernel module, condition constants) for a scene whose materials use these
+    update functions (in order), with one kind of shape function (0 linear, 1 uGIMP),
+    the scene's style-6 condition expressions (record index -> expression of t) and,
+    for a scene with cracks, the traction envelopes of its laws ("module:function",
+    index = kind in the law tables).  The module's ``advance`` is the step driver.
+    (A build without Numba's parallel loops for one-thread scenes compiles a third
+    faster but ran the beam 2.7x slower on one thread; not used until that is
+    understood.)"""
+    lines = Path(step_kernels.__file__).read_text().splitlines()
+    where = "step_kernels.py"
+    _replace_marked(lines, MARKER, _dispatch_source(update_functions), where)
+    _replace_marked(lines, SHAPE_MARKER, f"KIND = {int(shape)}  # shape functions of this build",
+                    where)
+    constants = np.zeros(0)
     if expressions:
-        fn = [i for i, line in enumerate(lines) if line.rstrip().endswith(FUNCTIONS_MARKER)]
-        if len(fn) != 1:
-            raise RuntimeError("step_kernels.py must have one condition-function marker")
-        lines[fn[0]] = _condition_source(expressions)
-    source = "\n".join(lines) + "\n"
-    return _load_source(source, "nairnmpm_kernels", update_functions + ["nairnmpm_py.core.shape:x"])
+        source, constants = condition_module_source(expressions)
+        _replace_marked(lines, FUNCTIONS_MARKER, source, where)
+    refs = update_functions + ["nairnmpm_py.core.shape:x", "nairnmpm_py.core.grid_ops:x",
+                               "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x"]
+    with_cracks = crack_envelopes is not None
+    if with_cracks:
+        cracks = _load_crack_tasks(shape, crack_envelopes)
+        crack_names = sorted({t.name for group in step_tasks(True) for t in group
+                              if t.module == CRACKS})
+        _replace_marked(lines, FIELDS_MARKER,
+                        f"from {cracks.__name__} import assign_and_scatter, "
+                        + ", ".join(crack_names), where)
+        _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
+        refs.append(cracks.__name__ + ":x")
+    source = "\n".join(lines) + "\n\n" + driver_source(with_cracks)
+    return _load_source(source, "nairnmpm_kernels", refs), constants
 
 
 def _dependency_text(refs: list[str]) -> str:
@@ -141,9 +158,10 @@ def _load_source(source: str, prefix: str, refs: list[str]):
     return module
 
 
-CRACK_BASE_MARKER = "# KERNEL-BASE"
 TRACTION_MARKER = "# KERNEL-TRACTION"
-CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.chords:x"]
+CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.chords:x",
+                      "nairnmpm_py.cracks.crack_lists:x", "nairnmpm_py.cracks.bundle:x",
+                      "nairnmpm_py.core.state:x", "nairnmpm_py.core.grid_ops:x"]
 
 
 def _traction_source(functions: list[str]) -> str:
@@ -161,18 +179,14 @@ def _traction_source(functions: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def load_crack_kernels(base, envelope_functions: list[str]):
-    """The crack step for a scene whose no-crack kernels are ``base`` (from
-    ``load_kernels``), dispatching over these traction envelopes ("module:function",
-    index = kind in the law tables)."""
-    from . import crack_step_kernels
-    lines = Path(crack_step_kernels.__file__).read_text().splitlines()
-    based = [i for i, line in enumerate(lines) if line.rstrip().endswith(CRACK_BASE_MARKER)]
-    traced = [i for i, line in enumerate(lines) if line.rstrip().endswith(TRACTION_MARKER)]
-    if len(based) != 1 or len(traced) != 1:
-        raise RuntimeError("crack_step_kernels.py must have one base and one traction marker")
-    lines[based[0]] = lines[based[0]].replace("nairnmpm_py.core.step_kernels", base.__name__)
-    lines[traced[0]] = _traction_source(envelope_functions)
+def _load_crack_tasks(shape: int, envelope_functions: list[str]):
+    """The crack tasks' template (``tasks.CRACKS``) built for this shape function and
+    dispatching over these traction envelopes."""
+    spec = importlib.util.find_spec(CRACKS)
+    lines = Path(spec.origin).read_text().splitlines()
+    where = Path(spec.origin).name
+    _replace_marked(lines, TRACTION_MARKER, _traction_source(envelope_functions), where)
+    _replace_marked(lines, SHAPE_MARKER, f"KIND = {int(shape)}  # shape functions of this build",
+                    where)
     source = "\n".join(lines) + "\n"
-    return _load_source(source, "nairnmpm_crack_kernels",
-                        envelope_functions + CRACK_DEPENDENCIES + [base.__name__ + ":x"])
+    return _load_source(source, "nairnmpm_crack_kernels", envelope_functions + CRACK_DEPENDENCIES)

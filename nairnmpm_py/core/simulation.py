@@ -13,15 +13,17 @@ from typing import Callable
 
 import numba
 import numpy as np
-from scipy.integrate import quad
 
 from ..errors import SimulationUnstable
-from .conditions import GRID_VELOCITY, ConditionRecord, Conditions, evaluate_expression
+from .conditions import GRID_VELOCITY, ConditionRecord, Conditions
 from .grid import Grid
 from .kernel_build import load_kernels, material_table
-from .load_couples import couple_moment, couples_opening, load_couples
 from .particles import Particles
+from .profile import StepProfile
+from .tasks import periodic_task
 from .shape import LINEAR, UGIMP
+from .state import (N_ROWS, NO_CRACKS, STATUS_CRACK_LEFT_GRID, STATUS_CRACK_LISTS_FULL,
+                    ConditionArrays, GridArrays, ParticleArrays, Settings, stress_split)
 
 # below this many particles, thread barriers cost more than threads give (a 200-particle
 # bar took 170 s on two busy cores and 0.2 s on one)
@@ -31,7 +33,9 @@ SHAPE_NAMES = {LINEAR: "linear", UGIMP: "uGIMP"}
 STATUS_TEXT = {1: "a value became NaN or infinite",
                2: "too many particles left the grid (LeaveLimit); the last one was",
                3: "a particle velocity ran away (time step too large for stability?)",
-               4: "a crack particle left the grid:"}
+               4: "a crack particle left the grid:",
+               5: "a crack's chords reach more cells than its lists hold (a crack stretched "
+                  "far beyond its particle spacing?):"}
 
 
 @dataclass
@@ -71,7 +75,9 @@ class Simulation:
         self.time = 0.0
         self.step = 0
         self.kernels = None
-        self.couples = []      # particle-load groups with a moment column (prepare)
+        self.profiler = None        # a StepProfile while a run is profiled
+        self.grid_current = False   # the grid holds the particles' current extrapolation
+        self.couples = None    # particle-load groups with a moment column (global row)
         self.rec_force = np.zeros(len(self.conditions.records))
         self.rec_work = np.zeros(len(self.conditions.records))
 
@@ -99,59 +105,6 @@ class Simulation:
     def n_steps(self) -> int:
         return int(math.ceil(self.max_time / self.dt - 1e-9))
 
-    # ---- results helpers -------------------------------------------------------
-    def prescribed_displacement(self, r: int, t: float) -> float:
-        """Displacement (mm) a grid velocity condition has imposed by time t."""
-        rec = self.conditions.records[r]
-        if t <= rec.t0:
-            return 0.0
-        s, v, w = t - rec.t0, rec.value, rec.ftime
-        if rec.style == 1:
-            return v * s
-        if rec.style == 2:
-            return 0.5 * v * s * s
-        if rec.style == 3:
-            return v * (1 - math.cos(w * s)) / w if w else 0.0
-        if rec.style == 4:
-            return v * math.sin(w * s) / w if w else v * s
-        if rec.style == 6:  # (a position-dependent expression is taken at x = y = 0)
-            return v * quad(lambda u: evaluate_expression(rec.function, u), 0.0, s, limit=200)[0]
-        return 0.0
-
-    def global_row(self) -> dict:
-        p = self.particles
-        row = {"time_ms": self.time, "step": self.step,
-               "kinetic_energy_J": p.kinetic_energy() * 1e-3,
-               "strain_energy_J": p.strain_energy() * 1e-3,
-               "external_work_J": float(np.sum(self.rec_work)) * 1e-3}
-        cond = self.conditions
-        part_ids = np.array(cond.part_ids, dtype=np.int64)
-        part_recs = np.array(cond.part_recs, dtype=np.int64)
-        for r, rec in enumerate(cond.records):
-            row[f"load_N_{rec.name}"] = float(self.rec_force[r])
-            if rec.kind == GRID_VELOCITY:
-                row[f"disp_mm_{rec.name}"] = self.prescribed_displacement(r, self.time)
-            else:
-                members = part_ids[part_recs == r]
-                d = rec.direction
-                row[f"disp_mm_{rec.name}"] = float(np.mean(p.pos[d, members] - p.pos0[d, members])) if members.size else 0.0
-        for couple in self.couples:
-            row[f"moment_Nmm_{couple.name}"] = couple_moment(couple, cond.records,
-                                                             self.rec_force, p.pos)
-        if len(self.couples) == 2:
-            a, b = self.couples
-            row[f"opening_mm_{a.name}_{b.name}"] = couples_opening(a, b, p.pos, p.pos0)
-        for q in self.global_quantities:
-            sel = slice(None) if q.material < 0 else (p.mat == q.material)
-            m = p.mass[sel]
-            axis = 0 if q.kind.endswith("x") else 1
-            if q.kind.startswith("vel"):
-                value = np.sum(m * p.vel[axis][sel]) / np.sum(m) * 1e3  # mm/s as NairnMPM
-            else:
-                value = np.sum(m * (p.pos[axis][sel] - p.pos0[axis][sel])) / np.sum(m)
-            row[q.column] = float(value)
-        return row
-
     # ---- running ---------------------------------------------------------------
     def prepare(self) -> None:
         """Sort particles by cell and compile (or load) the kernels."""
@@ -173,21 +126,29 @@ class Simulation:
             self.parallel = threads > 1 and p.n >= PARALLEL_MIN_PARTICLES
         expressions = {r: rec.function for r, rec in enumerate(self.conditions.records)
                        if rec.style == 6}
-        self.kernels = load_kernels(functions, self.shape, expressions)
+        envelopes = self.cracks.envelope_functions() if self.cracks is not None else None
+        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
-        self.g = np.zeros((5, nn))
-        self.gbuf = np.zeros((self.nch, 5, nn))
-        self.gv = np.zeros((2, nn))
-        self.ga = np.zeros((2, nn))
-        self.gvn = np.zeros((2, nn))
+        nf, rows = (self.cracks.nf, self.cracks.n_rows) if self.cracks else (1, N_ROWS)
+        self.g = np.zeros((nf, rows, nn))
+        self.gbuf = np.zeros((self.nch, nf, rows, nn))
+        self.gv = np.zeros((nf, 2, nn))
+        self.ga = np.zeros((nf, 2, nn))
+        self.gvn = np.zeros((nf, 2, nn))
         self.gtmp = np.zeros((2, nn))
         self.bad = np.zeros((self.nch, 4), dtype=np.int64)
         self.left = np.zeros(p.n, dtype=np.int8)
+        self.wij = np.zeros((p.n, 2), dtype=np.int64)
+        self.wc = np.zeros((p.n, 12))
+        self.clock = np.zeros(2)       # time, carried USAVG+ / USL+ stress half (state.CLOCK_*)
+        self.status = np.zeros(2, dtype=np.int64)
         self.leave_max = self.leave_limit if self.leave_limit > 0 else max(1, p.n // 100)
         self.sym_out, self.sym_in, self.sym_dir = self._symmetry_mirrors()
         self.cond_arrays = self.conditions.arrays()
-        self.couples = load_couples(self.conditions, p.pos, self.cracks)
+        npbc = self.cond_arrays["pbc_part"].size
+        self.pload = np.zeros(npbc)
+        self.pos_before = np.zeros(npbc)
         self.geom = g.geometry_vector()
         self.bounds = g.bounds()
         # any node with mass has a velocity: p/m is accurate even for tiny weights, and
@@ -245,40 +206,60 @@ class Simulation:
                 np.array([k[1] for k in keep], dtype=np.int64),
                 np.array([k[2] for k in keep], dtype=np.int64))
 
-    def advance(self, nsteps: int, flush: bool = True) -> None:
-        """Advance ``nsteps`` steps; raises SimulationUnstable if the run blows up.
-        ``flush=False`` (scenes with cracks) may leave the last USAVG+ stress half for
-        the next call: stresses and energies are then half a step behind until it."""
-        self.prepare()
+    def bundles(self):
+        """The state bundles (P, G, C, K, S) the step tasks take, over this scene's
+        current arrays (built per call, so arrays replaced from outside are seen)."""
         p = self.particles
         c = self.cond_arrays
+        P = ParticleArrays(p.pos, p.pos0, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress,
+                           p.hist, p.w, p.pdamp, self.left, self.wij, self.wc)
+        G = GridArrays(self.geom, self.bounds, self.g, self.gbuf, self.gv, self.ga, self.gvn,
+                       self.gtmp, self.bad)
+        C = ConditionArrays(c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"],
+                            c["pbc_dir"], c["pbc_scale"], c["pbc_face"], c["pbc_rec"],
+                            c["rec_style"], c["rec_value"], c["rec_t0"], c["rec_ftime"],
+                            self.rec_force, self.rec_work, self.sym_out, self.sym_in,
+                            self.sym_dir, self.pload, self.pos_before, self.fconst)
+        K = self.cracks.bundle(self) if self.cracks is not None else NO_CRACKS
+        first, last, update, plus = stress_split(self.method, self.post_extrapolate, self.dt)
+        S = Settings(float(self.dt), first, last, update, plus, bool(self.plane_stress),
+                     float(self.damping), float(self.mass_tol), float(self.vmax),
+                     int(self.leave_max), int(self.nch), self.mat_params, self.clock,
+                     self.status)
+        return P, G, C, K, S
+
+    def advance(self, nsteps: int, flush: bool = True) -> None:
+        """Advance ``nsteps`` steps; raises SimulationUnstable if the run blows up.
+        ``flush=False`` may leave the last USAVG+ / USL+ stress half for the next call:
+        stresses and energies are then half a step behind until it.  Particle arrays
+        changed from outside between calls need ``grid_current = False`` first."""
+        self.prepare()
+        p = self.particles
         threads = numba.get_num_threads()
         if not self.parallel:
             numba.set_num_threads(1)  # one chunk: no thread pool, no barriers
         try:
-            if self.cracks is not None:
-                done, status, bad = self.cracks.advance(self, nsteps, flush)
+            self.clock[0] = self.time
+            if self.profiler is None:
+                done = self.kernels.advance(*self.bundles(), nsteps, self.grid_current, flush)
             else:
-                done, status, bad = self.kernels.advance(
-                    nsteps, self.time, self.dt, self.method, self.post_extrapolate,
-                    self.plane_stress, p.pos, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F,
-                    p.stress, p.hist, p.w, p.pdamp, self.mat_params, self.geom, self.bounds,
-                    self.g, self.gbuf, self.gv, self.ga, self.gvn, self.gtmp, self.damping,
-                    self.mass_tol, self.vmax, self.left, self.leave_max,
-                    c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-                    c["pbc_scale"], c["pbc_face"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
-                    c["rec_ftime"], self.rec_force, self.rec_work, self.sym_out, self.sym_in,
-                    self.sym_dir, self.bad, self.nch)
+                done = self.kernels.advance_profiled(*self.bundles(), nsteps, self.grid_current,
+                                                     flush, self.profiler.cycles)
         finally:
             numba.set_num_threads(threads)
+        status, bad = int(self.status[0]), int(self.status[1])
+        self.grid_current = status == 0
         self.step += int(done)
         self.time += int(done) * self.dt
-        if status == 4:
+        if status == STATUS_CRACK_LEFT_GRID:
             cs = self.cracks.cracks
             raise SimulationUnstable(
                 f"{STATUS_TEXT[4]} crack {int(cs.crack[bad]) + 1}, crack particle {bad} at "
                 f"x = {cs.plane[0, bad]:.6g} mm, y = {cs.plane[1, bad]:.6g} mm",
                 self.step, self.time)
+        if status == STATUS_CRACK_LISTS_FULL:
+            raise SimulationUnstable(f"{STATUS_TEXT[5]} {bad} chord-cell entries",
+                                     self.step, self.time)
         if status != 0:
             name = self.material_names[p.mat[bad]] if self.material_names else p.mat[bad]
             where = (f"particle {bad} (material '{name}') at x = {p.pos[0, bad]:.6g} mm, "
@@ -287,16 +268,24 @@ class Simulation:
                                      self.step, self.time)
 
     def run(self, outputs: list | None = None,
-            progress: Callable[[float, float, int, float], None] | None = None) -> dict:
+            progress: Callable[[float, float, int, float], None] | None = None,
+            profile: bool = False) -> dict:
         """Run to ``max_time``.  ``progress(fraction, time_ms, step, steps_per_s)``.
 
         Output plugins get ``begin(sim)``, ``on_global(sim, row)``,
         ``on_archive(sim)`` and ``end(sim, status)``; they are always ended, also
         when the run blows up or is interrupted, so what they wrote stays readable.
+        With ``profile`` the returned status (and run.json) gets ``"profile"``: each
+        task's time per step and share of the run (``core/profile``).
         """
         outputs = outputs or []
         t_wall = wallclock.perf_counter()
         self.prepare()
+        self.grid_current = False   # the particles may have been changed since
+        self.profiler = StepProfile(self.cracks is not None) if profile else None
+        self.advance(0, flush=False)   # compiles the driver; extrapolates the start
+        if self.profiler is not None:
+            self.profiler.cycles[:] = 0
         self.compile_seconds = wallclock.perf_counter() - t_wall
         dt = self.dt
         total = self.n_steps
@@ -316,6 +305,10 @@ class Simulation:
             self._emit(outputs, archive=True, glob=True)
             chunk = 20
             start_run = wallclock.perf_counter()
+            step0 = self.step
+            timed = self.profiler.timed if self.profiler is not None else _untimed
+            if self.profiler is not None:
+                self.profiler.start()
             scene = self.cracks
             growing = scene is not None and scene.growing
             while self.step < total:
@@ -328,7 +321,7 @@ class Simulation:
                          or target >= step_at(next_glob))
                 self.advance(target - self.step, flush=emits)
                 if growing and self.step % scene.check_steps == 0:
-                    grown = scene.propagate(self)
+                    grown = timed("propagation", periodic_task("propagation"), self)
                     if grown:
                         for o in outputs:
                             hook = getattr(o, "on_crack_growth", None)
@@ -344,7 +337,7 @@ class Simulation:
                     next_arch += arch_dt
                 while self.step >= step_at(next_glob):
                     next_glob += glob_dt
-                self._emit(outputs, archive=archive, glob=glob)
+                self._emit(outputs, archive=archive, glob=glob, timed=timed)
                 if progress is not None:
                     el = wallclock.perf_counter() - start_run
                     progress(self.step / total, self.time, self.step, self.step / max(el, 1e-9))
@@ -358,15 +351,30 @@ class Simulation:
         finally:
             status["wall_seconds"] = wallclock.perf_counter() - t_wall
             status["steps"] = self.step
+            if self.profiler is not None and self.profiler.wall0 is not None:
+                self.profiler.stop()
+                status["profile"] = self.profiler.rows(self.step - step0)
+            self.profiler = None
             for o in outputs:
                 o.end(self, status)
         return status
 
-    def _emit(self, outputs, archive: bool, glob: bool) -> None:
+    def _emit(self, outputs, archive: bool, glob: bool, timed=None) -> None:
+        timed = timed or _untimed
         if glob:
-            row = self.global_row()
-            for o in outputs:
-                o.on_global(self, row)
+            timed("global_archive", self._emit_global, outputs)
         if archive:
-            for o in outputs:
-                o.on_archive(self)
+            timed("archive", self._emit_archive, outputs)
+
+    def _emit_global(self, outputs) -> None:
+        row = periodic_task("global_archive")(self)
+        for o in outputs:
+            o.on_global(self, row)
+
+    def _emit_archive(self, outputs) -> None:
+        for o in outputs:
+            o.on_archive(self)
+
+
+def _untimed(name, fn, *args):
+    return fn(*args)

@@ -1,26 +1,32 @@
-"""The explicit MPM time step as fused Numba kernels.
+"""The tasks of the explicit MPM time step, as Numba kernels.
+
+``core/tasks.py`` lists them in order; this file is their one source.  Every task
+has the signature ``task(P, G, C, K, S)`` over the state bundles of ``core/state``.
 
 This file is a template as well as a module: ``kernel_build`` copies it into a cache
-folder with the ``material_update`` import replaced by a dispatcher over the
-materials of one scene and ``KIND`` set to its shape functions, so the stress update
-of any material plugin is inlined in the particle loops, the shape function is known
-at compile time, and everything stays ``cache=True``.  Imported directly it runs
-uGIMP with the isotropic material only.
+folder with the scene's material dispatcher, shape functions (``KIND``), style-6
+condition expressions and velocity fields filled in at the marked lines, and appends
+the driver it composes from the task list, so the stress update of any material
+plugin is inlined in the particle loops and everything stays ``cache=True``.
+Imported directly it runs uGIMP with the isotropic material and one field.
 
-One step (``advance`` runs many without returning to Python):
+Fields: a scene without cracks has one velocity field per node (``MULTI_FIELD``
+False: every field index below is the constant 0 and compiles away).  A scene with
+cracks builds this file with ``MULTI_FIELD`` True and the crack module's
+``assign_and_scatter``, which chooses each particle's field at each of its nodes
+(``K.vfld``; ``K.cut`` 0 for a particle that touches no crack node); every pass here
+then reads and writes the particle's own field.
 
-1. particle loads onto the grid; stress update from the grid velocities (USF /
-   USAVG first half, plus a carried-over USAVG+ / USL+ last half) fused with the
-   internal forces back to the grid;
-2. forces summed, momenta updated, velocity conditions on the new momenta
-   (reactions recorded);
-3. grid -> particles: FLIP velocity and position with grid and particle damping (as
-   NairnMPM applies them), the USL- / USAVG- stress update, then the particle's new
-   weights and its mass and momentum back to the grid for the next step;
-4. mass and momentum summed, velocity conditions at the new time.
+Every task and chunk function is compiled without a Python entry point
+(``no_cpython_wrapper``): only the driver calls them, and the unboxing code of five
+bundles would cost about a second of compiling each.
 
 Particle loops run as fixed chunks, each with its own grid buffer, reduced in a fixed
-order: results do not depend on thread scheduling.  ``FAST`` allows reassociation and
+order: results do not depend on thread scheduling.  A parallel task's ``prange`` body
+only calls the chunk's function with the bundles and an int64 chunk index: Numba 0.68
+loses writes made through a bundle's arrays inside a ``prange`` body itself
+(measured), not through those of a function it calls, and the index would otherwise
+arrive as uint64 in one compile and int64 in another (two compiles of each chunk).  ``FAST`` allows reassociation and
 fused multiply-adds but keeps NaN and infinity semantics, so blow-ups are still caught.
 """
 from __future__ import annotations
@@ -30,27 +36,21 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from nairnmpm_py.core.grid_ops import accelerate_node
 from nairnmpm_py.core.shape import weights_1d
+from nairnmpm_py.core.state import (GM, GPX, GPY, GFX, GFY, CLOCK_T, CLOCK_PENDING, STATUS_OK,
+                                    STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY)
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
-from nairnmpm_py.core.conditions import no_condition_function as condition_function  # KERNEL-FUNCTIONS
+from nairnmpm_py.core.expressions import no_condition_function as condition_function  # KERNEL-FUNCTIONS
+from nairnmpm_py.core.single_field import assign_and_scatter  # KERNEL-FIELDS
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
+MULTI_FIELD = False  # KERNEL-MULTI-FIELD: more than one velocity field per node
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
 FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
 
-USF = 0
-USAVG = 2
-USL = 3
 
-STATUS_OK = 0
-STATUS_NONFINITE = 1
-STATUS_LEFT_GRID = 2
-STATUS_RUNAWAY = 3
-
-# grid component rows
-GM, GPX, GPY, GFX, GFY = 0, 1, 2, 3, 4
-
-
+# ---- condition values ----------------------------------------------------------------
 @njit(cache=True, inline="always")
 def bc_active(style, t0, t):
     """Constant and ramp conditions start at t0 (node free before); sine and
@@ -61,7 +61,7 @@ def bc_active(style, t0, t):
 
 
 @njit(cache=True, inline="always")
-def bc_value(r, style, value, t0, ftime, t, x, y, q):
+def bc_value(C, r, t, x, y, q):
     """Value of boundary condition record r at time t (ms).
 
     style 1 constant, 2 linear ramp value*(t - t0) (value per ms),
@@ -69,16 +69,19 @@ def bc_value(r, style, value, t0, ftime, t, x, y, q):
     record's expression of t - t0 (ms; zero before t0), of the position x, y (mm) of
     the node or particle and of the particle's rotation q (radians).
     """
+    style = C.rec_style[r]
+    value = C.rec_value[r]
+    t0 = C.rec_t0[r]
     if style == 1:
         return value if t >= t0 else 0.0
     if style == 2:
         return value * (t - t0) if t >= t0 else 0.0
     if style == 3:
-        return value * math.sin(ftime * t)
+        return value * math.sin(C.rec_ftime[r] * t)
     if style == 4:
-        return value * math.cos(ftime * t)
+        return value * math.cos(C.rec_ftime[r] * t)
     if style == 6:
-        return value * condition_function(r, t - t0, x, y, q) if t >= t0 else 0.0
+        return value * condition_function(r, t - t0, x, y, q, C.fconst) if t >= t0 else 0.0
     return 0.0
 
 
@@ -98,6 +101,16 @@ def particle_rotation(F, p):
     return math.atan2(F[2, p] - F[1, p], F[0, p] + F[3, p])
 
 
+@njit(cache=True, inline="always")
+def field_at(K, p, slot):
+    """The velocity field particle p uses at the ``slot``-th node of its stencil."""
+    if MULTI_FIELD:
+        if K.cut[p]:
+            return K.vfld[p, slot]
+    return 0
+
+
+# ---- particle loads ------------------------------------------------------------------
 @njit(cache=True, inline="always")
 def face_corner(pos, lp, F, geom, p, face, corner):
     """Corner 0 or 1 of face ``face`` (1 bottom, 2 right, 3 top, 4 left) of particle p,
@@ -134,68 +147,159 @@ def face_node(pos, lp, F, geom, nny, p, face, m):
     return i + a, j + b, 0.5 * (fx if a == 1 else 1.0 - fx) * (fy if b == 1 else 1.0 - fy)
 
 
-@njit(cache=True, error_model="numpy")
-def _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
-                   rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload):
-    """Particle loads (N) at time t onto the grid; pload keeps them for the work."""
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def scatter_loads(P, G, C, K, S):
+    """Clear the grid forces, then the particle loads (N) at this time onto the grid,
+    in the field the particle uses at each node; ``C.pload`` keeps them for the work,
+    ``C.pos_before`` the loaded particles' positions."""
+    g = G.g
+    geom = G.geom
+    pos = P.pos
+    C.rec_force[:] = 0.0
+    g[:, GFX] = 0.0
+    g[:, GFY] = 0.0
+    t = S.clock[CLOCK_T]
     nnx = int(geom[4])
-    na = NA
-    for q in range(pbc_part.size):
-        r = pbc_rec[q]
-        p = pbc_part[q]
-        f = pbc_scale[q] * bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
-                                    pos[0, p], pos[1, p], particle_rotation(F, p))
-        pload[q] = f
-        rec_force[r] += f
-        row_c = GFX + pbc_dir[q]
-        if pbc_face[q] > 0:
-            # a traction: on the face's nodes that have mass
+    for q in range(C.pbc_part.size):
+        r = C.pbc_rec[q]
+        p = C.pbc_part[q]
+        C.pos_before[q] = pos[C.pbc_dir[q], p]
+        f = C.pbc_scale[q] * bc_value(C, r, t, pos[0, p], pos[1, p], particle_rotation(P.F, p))
+        C.pload[q] = f
+        C.rec_force[r] += f
+        row_c = GFX + C.pbc_dir[q]
+        if C.pbc_face[q] > 0:
+            # a traction: on the face's nodes that have mass, in the field the particle
+            # uses at that node (field 0 outside its own nodes)
             for m in range(8):
-                i, j, sw = face_node(pos, lp, F, geom, g.shape[1] // nnx, p, pbc_face[q], m)
-                if g[GM, j * nnx + i] > 0.0:
-                    g[row_c, j * nnx + i] += sw * f
+                i, j, sw = face_node(pos, P.lp, P.F, geom, g.shape[2] // nnx, p, C.pbc_face[q], m)
+                pa = i - P.wij[p, 0]
+                pb = j - P.wij[p, 1]
+                fld = 0
+                if 0 <= pa < NA and 0 <= pb < NA:
+                    fld = field_at(K, p, pb * NA + pa)
+                if g[fld, GM, j * nnx + i] > 0.0:
+                    g[fld, row_c, j * nnx + i] += sw * f
             continue
-        xi = (pos[0, p] - geom[0]) / geom[2]
-        eta = (pos[1, p] - geom[1]) / geom[3]
-        i0, sx0, sx1, sx2, dx0, dx1, dx2 = weights_1d(xi, KIND, lp[0, p])
-        j0, sy0, sy1, sy2, dy0, dy1, dy2 = weights_1d(eta, KIND, lp[1, p])
-        for b in range(na):
-            sy = sy0 if b == 0 else (sy1 if b == 1 else sy2)
-            row = (j0 + b) * nnx + i0
-            for a in range(na):
-                s = sy * (sx0 if a == 0 else (sx1 if a == 1 else sx2))
-                g[row_c, row + a] += s * f
+        wq = P.wc[p]
+        for b in range(NA):
+            row = (P.wij[p, 1] + b) * nnx + P.wij[p, 0]
+            for a in range(NA):
+                g[field_at(K, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
 
 
-@njit(cache=True, error_model="numpy")
-def _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
-                         rec_ftime, sym_out, sym_in, sym_dir, t):
-    """Impose velocity conditions on the extrapolated momenta.
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def load_work(P, G, C, K, S):
+    """Work (mJ) of each particle load over the step just taken."""
+    for q in range(C.pbc_part.size):
+        p = C.pbc_part[q]
+        C.rec_work[C.pbc_rec[q]] += C.pload[q] * (P.pos[C.pbc_dir[q], p] - C.pos_before[q])
+
+
+# ---- velocity conditions ---------------------------------------------------------------
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def momentum_conditions(P, G, C, K, S):
+    """Impose velocity conditions on the extrapolated momenta of every field, then
+    the velocities of the conditioned nodes.
 
     Several conditions on one node and direction add up (zero first, then add).
     Nodes just outside a symmetry plane mirror the normal velocity of the node
-    inside it."""
-    for q in range(gbc_node.size):
-        r = gbc_rec[q]
-        if bc_active(rec_style[r], rec_t0[r], t):
-            g[GPX + gbc_dir[q], gbc_node[q]] = 0.0
-    for q in range(gbc_node.size):
-        r = gbc_rec[q]
-        if bc_active(rec_style[r], rec_t0[r], t):
-            k = gbc_node[q]
-            v = bc_value(r, rec_style[r], rec_value[r], rec_t0[r], rec_ftime[r], t,
-                         node_x(k, geom), node_y(k, geom), 0.0)
-            g[GPX + gbc_dir[q], k] += g[GM, k] * v
-    for q in range(sym_out.size):
-        ko = sym_out[q]
-        ki = sym_in[q]
-        d = sym_dir[q]
-        if g[GM, ki] > 0.0:
-            g[GPX + d, ko] = -g[GM, ko] * g[GPX + d, ki] / g[GM, ki]
-        else:
-            g[GPX + d, ko] = 0.0
+    inside it (in the same field, or field 0 where that one is empty)."""
+    g = G.g
+    gv = G.gv
+    nf = g.shape[0]
+    t = S.clock[CLOCK_T]
+    for q in range(C.gbc_node.size):
+        r = C.gbc_rec[q]
+        if bc_active(C.rec_style[r], C.rec_t0[r], t):
+            for f in range(nf):
+                g[f, GPX + C.gbc_dir[q], C.gbc_node[q]] = 0.0
+    for q in range(C.gbc_node.size):
+        r = C.gbc_rec[q]
+        if bc_active(C.rec_style[r], C.rec_t0[r], t):
+            k = C.gbc_node[q]
+            v = bc_value(C, r, t, node_x(k, G.geom), node_y(k, G.geom), 0.0)
+            for f in range(nf):
+                g[f, GPX + C.gbc_dir[q], k] += g[f, GM, k] * v
+    for q in range(C.sym_out.size):
+        ko = C.sym_out[q]
+        ki = C.sym_in[q]
+        d = C.sym_dir[q]
+        for f in range(nf):
+            fi = f if g[f, GM, ki] > 0.0 else 0
+            if g[fi, GM, ki] > 0.0:
+                g[f, GPX + d, ko] = -g[f, GM, ko] * g[fi, GPX + d, ki] / g[fi, GM, ki]
+            else:
+                g[f, GPX + d, ko] = 0.0
+    for nodes in (C.gbc_node, C.sym_out):
+        for q in range(nodes.size):
+            k = nodes[q]
+            for f in range(nf):
+                m = g[f, GM, k]
+                if m > S.mass_tol:
+                    gv[f, 0, k] = g[f, GPX, k] / m
+                    gv[f, 1, k] = g[f, GPY, k] / m
+                else:
+                    gv[f, 0, k] = 0.0
+                    gv[f, 1, k] = 0.0
 
 
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def velocity_conditions(P, G, C, K, S):
+    """Impose v(t+dt) on conditioned nodes in every field; the force that takes is
+    the reaction (summed over the fields)."""
+    g = G.g
+    ga = G.ga
+    gvn = G.gvn
+    gtmp = G.gtmp
+    nf = g.shape[0]
+    t = S.clock[CLOCK_T]
+    dt = S.dt
+    for q in range(C.gbc_node.size):
+        r = C.gbc_rec[q]
+        if bc_active(C.rec_style[r], C.rec_t0[r], t):
+            gtmp[C.gbc_dir[q], C.gbc_node[q]] = 0.0
+    for q in range(C.gbc_node.size):
+        r = C.gbc_rec[q]
+        if bc_active(C.rec_style[r], C.rec_t0[r], t):
+            k = C.gbc_node[q]
+            gtmp[C.gbc_dir[q], k] += bc_value(C, r, t + dt, node_x(k, G.geom),
+                                              node_y(k, G.geom), 0.0)
+    for q in range(C.gbc_node.size):
+        r = C.gbc_rec[q]
+        if not bc_active(C.rec_style[r], C.rec_t0[r], t):
+            continue
+        k = C.gbc_node[q]
+        d = C.gbc_dir[q]
+        v_new = gtmp[d, k]
+        for f in range(nf):
+            m = g[f, GM, k]
+            if m <= S.mass_tol:
+                continue
+            v_old = g[f, GPX + d, k] / m
+            f_needed = m * (v_new - v_old) / dt
+            # a node shared by several conditions credits its reaction to the first one
+            reaction = f_needed - g[f, GFX + d, k]
+            g[f, GFX + d, k] = f_needed
+            ga[f, d, k] = f_needed / m
+            gvn[f, d, k] = v_new
+            C.rec_force[r] += reaction
+            C.rec_work[r] += reaction * 0.5 * (v_old + v_new) * dt
+    for q in range(C.sym_out.size):
+        ko = C.sym_out[q]
+        ki = C.sym_in[q]
+        d = C.sym_dir[q]
+        for f in range(nf):
+            m = g[f, GM, ko]
+            if m > S.mass_tol:
+                fi = f if g[f, GM, ki] > 0.0 else 0
+                v_new = -gvn[fi, d, ki]
+                v_old = g[f, GPX + d, ko] / m
+                gvn[f, d, ko] = v_new
+                ga[f, d, ko] = (v_new - v_old) / dt
+
+
+# ---- stress updates --------------------------------------------------------------------
 @njit(cache=True, inline="always")
 def _increment_exp(L00, L01, L10, L11, dt):
     """exp(L dt) of a 2x2 velocity gradient: exact for rigid rotations, so no spurious
@@ -240,97 +344,171 @@ def _apply_increment(p, e00, e01, e10, e11, F):
 
 
 @njit(cache=True, inline="always")
-def _stress_update(p, dt, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
-                   plane_stress):
-    e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt)
-    _apply_increment(p, e00, e01, e10, e11, F)
-    m = mat[p]
-    material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
-                    plane_stress)
-
-
-@njit(cache=True, inline="always")
-def _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
-                    mat_params, plane_stress):
-    """The stress updates of one particle's stress pass with one velocity gradient: a
-    carried-over USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either
-    may be 0).  USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is
-    found once and applied twice (the same numbers as two separate updates)."""
-    if dt_pre == dt_stress and dt_pre > 0.0:
-        e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_pre)
-        m = mat[p]
-        _apply_increment(p, e00, e01, e10, e11, F)
-        material_update(m, p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
-                        plane_stress)
-        _apply_increment(p, e00, e01, e10, e11, F)
-        material_update(m, p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
-                        plane_stress)
-        return
-    if dt_pre > 0.0:
-        _stress_update(p, dt_pre, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
-                       plane_stress)
-    if dt_stress > 0.0:
-        _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat, mat_params,
-                       plane_stress)
-
-
-@njit(cache=True, error_model="numpy")
-def _velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
-                               rec_value, rec_t0, rec_ftime, rec_force, rec_work,
-                               sym_out, sym_in, sym_dir, t, dt, mass_tol):
-    """Impose v(t+dt) on conditioned nodes; the force that takes is the reaction."""
-    for q in range(gbc_node.size):
-        r = gbc_rec[q]
-        if bc_active(rec_style[r], rec_t0[r], t):
-            gtmp[gbc_dir[q], gbc_node[q]] = 0.0
-    for q in range(gbc_node.size):
-        r = gbc_rec[q]
-        if bc_active(rec_style[r], rec_t0[r], t):
-            k = gbc_node[q]
-            gtmp[gbc_dir[q], k] += bc_value(r, rec_style[r], rec_value[r], rec_t0[r],
-                                            rec_ftime[r], t + dt, node_x(k, geom),
-                                            node_y(k, geom), 0.0)
-    for q in range(gbc_node.size):
-        r = gbc_rec[q]
-        k = gbc_node[q]
-        d = gbc_dir[q]
-        m = g[GM, k]
-        if m <= mass_tol or not bc_active(rec_style[r], rec_t0[r], t):
+def _stress_updates(P, S, p, dt_pre, dt_stress, L00, L01, L10, L11):
+    """The stress updates of one particle with one velocity gradient: a carried-over
+    USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either may be 0).
+    USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is found once
+    and applied twice (the same numbers as two separate updates).  One call site of
+    the material update, so its inlined code exists once per pass."""
+    e00 = e01 = e10 = e11 = 0.0
+    m = P.mat[p]
+    for i in range(2):
+        dt_i = dt_pre if i == 0 else dt_stress
+        if dt_i <= 0.0:
             continue
-        v_new = gtmp[d, k]
-        v_old = g[GPX + d, k] / m
-        f_needed = m * (v_new - v_old) / dt
-        # a node shared by several conditions credits its reaction to the first one
-        reaction = f_needed - g[GFX + d, k]
-        g[GFX + d, k] = f_needed
-        ga[d, k] = f_needed / m
-        gvn[d, k] = v_new
-        rec_force[r] += reaction
-        rec_work[r] += reaction * 0.5 * (v_old + v_new) * dt
-    for q in range(sym_out.size):
-        ko = sym_out[q]
-        d = sym_dir[q]
-        m = g[GM, ko]
+        if i == 0 or dt_pre != dt_stress:
+            e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_i)
+        _apply_increment(p, e00, e01, e10, e11, P.F)
+        material_update(m, p, dt_i, L00, L01, L10, L11, P.F, P.stress, P.hist, P.w,
+                        S.mat_params[m], S.plane_stress)
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def _stress_chunk(P, G, K, S, c, dt_pre, dt_stress, scatter):
+    """Chunk c of the stress pass: each particle's velocity gradient from its own
+    fields' grid velocities, its stress updates (``_stress_updates``), and with
+    ``scatter`` its internal forces into the same fields of the chunk's buffer."""
+    n = P.pos.shape[1]
+    nch = S.nch
+    nnx = int(G.geom[4])
+    gv = G.gv
+    buf = G.gbuf[c]
+    if scatter:
+        buf[0, GFX] = 0.0
+        buf[0, GFY] = 0.0
+    lo = c * n // nch
+    hi = (c + 1) * n // nch
+    for p in range(lo, hi):
+        r = P.wc[p]
+        i0 = P.wij[p, 0]
+        j0 = P.wij[p, 1]
+        if dt_stress > 0.0 or dt_pre > 0.0:
+            L00 = 0.0
+            L01 = 0.0
+            L10 = 0.0
+            L11 = 0.0
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    f = field_at(K, p, b * NA + a)
+                    gx = r[6 + a] * sy
+                    gy = r[a] * dy
+                    vx = gv[f, 0, k]
+                    vy = gv[f, 1, k]
+                    L00 += vx * gx
+                    L01 += vx * gy
+                    L10 += vy * gx
+                    L11 += vy * gy
+            _stress_updates(P, S, p, dt_pre, dt_stress, L00, L01, L10, L11)
+        if not scatter:
+            continue
+        F = P.F
+        vol = P.vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
+        sxx = P.stress[0, p] * vol
+        syy = P.stress[1, p] * vol
+        sxy = P.stress[2, p] * vol
+        for b in range(NA):
+            sy = r[3 + b]
+            dy = r[9 + b]
+            row = (j0 + b) * nnx + i0
+            for a in range(NA):
+                k = row + a
+                f = field_at(K, p, b * NA + a)
+                gx = r[6 + a] * sy
+                gy = r[a] * dy
+                buf[f, GFX, k] -= sxx * gx + sxy * gy
+                buf[f, GFY, k] -= sxy * gx + syy * gy
+
+
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
+def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
+    for c in prange(S.nch):
+        _stress_chunk(P, G, K, S, np.int64(c), dt_pre, dt_stress, scatter)
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def stress_and_forces(P, G, C, K, S):
+    """Stress update (USF / USAVG first half, plus a carried-over USAVG+ / USL+ last
+    half) fused with the internal forces into the chunk buffers."""
+    pending = S.clock[CLOCK_PENDING]
+    S.clock[CLOCK_PENDING] = 0.0
+    _stress_pass(P, G, K, S, pending, S.dt_first, S.nch > 0)   # a runtime True (see flush)
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def flush_stress(P, G, C, K, S):
+    """Apply a carried USAVG+ / USL+ stress half now (before stresses or energies are
+    read, or when a run stops)."""
+    pending = S.clock[CLOCK_PENDING]
+    if pending > 0.0:
+        S.clock[CLOCK_PENDING] = 0.0
+        # a runtime False: a literal would make Numba compile the whole pass twice
+        _stress_pass(P, G, K, S, 0.0, pending, S.nch < 0)
+
+
+# ---- grid ------------------------------------------------------------------------------
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def reduce_forces(P, G, C, K, S):
+    """Add the chunks' internal forces of field 0 to the grid forces (the loads)."""
+    g = G.g
+    gbuf = G.gbuf
+    nch = S.nch
+    for k in prange(g.shape[2]):
+        fx = 0.0
+        fy = 0.0
+        for c in range(nch):
+            fx += gbuf[c, 0, GFX, k]
+            fy += gbuf[c, 0, GFY, k]
+        g[0, GFX, k] += fx
+        g[0, GFY, k] += fy
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def accelerate(P, G, C, K, S):
+    """Field 0's accelerations and updated velocities on every node."""
+    dt = S.dt
+    mass_tol = S.mass_tol
+    g = G.g
+    ga = G.ga
+    gvn = G.gvn
+    for k in prange(g.shape[2]):
+        accelerate_node(g, ga, gvn, 0, k, dt, mass_tol)
+
+
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def reduce_extrapolation(P, G, C, K, S):
+    """Sum the chunks' mass and momentum of field 0 and its velocities (before
+    conditions)."""
+    g = G.g
+    gv = G.gv
+    gbuf = G.gbuf
+    nch = S.nch
+    mass_tol = S.mass_tol
+    for k in prange(g.shape[2]):
+        m = 0.0
+        px = 0.0
+        py = 0.0
+        for c in range(nch):
+            m += gbuf[c, 0, GM, k]
+            px += gbuf[c, 0, GPX, k]
+            py += gbuf[c, 0, GPY, k]
+        g[0, GM, k] = m
+        g[0, GPX, k] = px
+        g[0, GPY, k] = py
         if m > mass_tol:
-            v_new = -gvn[d, sym_in[q]]
-            v_old = g[GPX + d, ko] / m
-            gvn[d, ko] = v_new
-            ga[d, ko] = (v_new - v_old) / dt
+            gv[0, 0, k] = px / m
+            gv[0, 1, k] = py / m
+        else:
+            gv[0, 0, k] = 0.0
+            gv[0, 1, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
-def _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec):
-    for q in range(pbc_part.size):
-        p = pbc_part[q]
-        d = pbc_dir[q]
-        rec_work[pbc_rec[q]] += pload[q] * (pos[d, p] - pos_before[q])
-
-
-
-# ---- cached weights ------------------------------------------------------------------
+# ---- particles -> grid -----------------------------------------------------------------
 # wc[p] = (sx0, sx1, sx2, sy0, sy1, sy2, gx0, gx1, gx2, gy0, gy1, gy2) with the
 # derivatives already divided by the cell size; wij[p] = (i0, j0)
-
 
 @njit(cache=True, inline="always")
 def _store_weights(p, pos, lp, geom, idx, idy, wij, wc):
@@ -355,338 +533,190 @@ def _store_weights(p, pos, lp, geom, idx, idy, wij, wc):
     r[11] = dy2 * idy
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def _weights_and_mass(pos, vel, mass, lp, geom, wij, wc, gbuf, nch):
-    """Weights of every particle (cached) and their mass and momentum on the grid."""
-    n = pos.shape[1]
+@njit(cache=True, inline="always")
+def scatter_mass_momentum(b0, r, i0, j0, nnx, m, mvx, mvy):
+    """A particle's mass and momentum onto one field's buffer rows."""
+    for b in range(NA):
+        sy = r[3 + b]
+        row = (j0 + b) * nnx + i0
+        for a in range(NA):
+            s = sy * r[a]
+            k = row + a
+            b0[GM, k] += s * m
+            b0[GPX, k] += s * mvx
+            b0[GPY, k] += s * mvy
+
+
+@njit(cache=True, inline="always")
+def _scatter_particle(P, G, K, buf, p, nnx, conflicts):
+    """Particle p's mass and momentum to the grid: its field choice and crack rows in
+    a multi-field build, else field 0."""
+    if MULTI_FIELD:
+        return assign_and_scatter(P, G, K, buf, p, conflicts)
+    m = P.mass[p]
+    scatter_mass_momentum(buf[0], P.wc[p], P.wij[p, 0], P.wij[p, 1], nnx, m,
+                          m * P.vel[0, p], m * P.vel[1, p])
+    return conflicts
+
+
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def _weights_chunk(P, G, K, S, c):
+    n = P.pos.shape[1]
+    nch = S.nch
+    geom = G.geom
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
     idy = 1.0 / geom[3]
-    for c in prange(nch):
-        buf = gbuf[c]
-        buf[:] = 0.0
-        lo = c * n // nch
-        hi = (c + 1) * n // nch
-        for p in range(lo, hi):
-            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
-            r = wc[p]
-            m = mass[p]
-            mvx = m * vel[0, p]
-            mvy = m * vel[1, p]
-            for b in range(NA):
-                sy = r[3 + b]
-                row = (wij[p, 1] + b) * nnx + wij[p, 0]
-                for a in range(NA):
-                    s = sy * r[a]
-                    k = row + a
-                    buf[GM, k] += s * m
-                    buf[GPX, k] += s * mvx
-                    buf[GPY, k] += s * mvy
+    buf = G.gbuf[c]
+    buf[0, GM] = 0.0
+    buf[0, GPX] = 0.0
+    buf[0, GPY] = 0.0
+    conflicts = 0
+    for p in range(c * n // nch, (c + 1) * n // nch):
+        _store_weights(p, P.pos, P.lp, geom, idx, idy, P.wij, P.wc)
+        conflicts = _scatter_particle(P, G, K, buf, p, nnx, conflicts)
+    if MULTI_FIELD:
+        K.chunk_counts[c] = conflicts
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def _reduce_velocity(gbuf, g, gv, mass_tol, nch):
-    """Sum the chunks' mass and momentum and the grid velocities (before conditions)."""
-    nn = g.shape[1]
-    for k in prange(nn):
-        m = 0.0
-        px = 0.0
-        py = 0.0
-        for c in range(nch):
-            m += gbuf[c, GM, k]
-            px += gbuf[c, GPX, k]
-            py += gbuf[c, GPY, k]
-        g[GM, k] = m
-        g[GPX, k] = px
-        g[GPY, k] = py
-        if m > mass_tol:
-            gv[0, k] = px / m
-            gv[1, k] = py / m
-        else:
-            gv[0, k] = 0.0
-            gv[1, k] = 0.0
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
+def weights_and_mass(P, G, C, K, S):
+    """Weights of every particle (cached) and their mass and momentum on the grid."""
+    for c in prange(S.nch):
+        _weights_chunk(P, G, K, S, np.int64(c))
 
 
-@njit(cache=True, error_model="numpy")
-def _velocity_at(g, gv, nodes, mass_tol):
-    for q in range(nodes.size):
-        k = nodes[q]
-        m = g[GM, k]
-        if m > mass_tol:
-            gv[0, k] = g[GPX, k] / m
-            gv[1, k] = g[GPY, k] / m
-        else:
-            gv[0, k] = 0.0
-            gv[1, k] = 0.0
-
-
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
-                         geom, wij, wc, gv, gbuf, nch, dt_pre, dt_stress, scatter, n):
+# ---- grid -> particles -----------------------------------------------------------------
+@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def _update_chunk(P, G, K, S, c):
+    n = P.pos.shape[1]
+    nch = S.nch
+    geom = G.geom
     nnx = int(geom[4])
-    for c in prange(nch):
-        buf = gbuf[c]
-        if scatter:
-            buf[GFX] = 0.0
-            buf[GFY] = 0.0
-        lo = c * n // nch
-        hi = (c + 1) * n // nch
-        for p in range(lo, hi):
-            r = wc[p]
-            i0 = wij[p, 0]
-            j0 = wij[p, 1]
-            if dt_stress > 0.0 or dt_pre > 0.0:
-                L00 = 0.0
-                L01 = 0.0
-                L10 = 0.0
-                L11 = 0.0
-                for b in range(NA):
-                    sy = r[3 + b]
-                    dy = r[9 + b]
-                    row = (j0 + b) * nnx + i0
-                    for a in range(NA):
-                        k = row + a
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
-                        L00 += gv[0, k] * gx
-                        L01 += gv[0, k] * gy
-                        L10 += gv[1, k] * gx
-                        L11 += gv[1, k] * gy
-                _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, F, stress, hist, w,
-                                mat, mat_params, plane_stress)
-            if not scatter:
-                continue
-            vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
-            sxx = stress[0, p] * vol
-            syy = stress[1, p] * vol
-            sxy = stress[2, p] * vol
-            for b in range(NA):
-                sy = r[3 + b]
-                dy = r[9 + b]
-                row = (j0 + b) * nnx + i0
-                for a in range(NA):
-                    k = row + a
+    idx = 1.0 / geom[2]
+    idy = 1.0 / geom[3]
+    dt = S.dt
+    dt_stress = S.dt_update
+    damping = S.damping
+    vmax = S.vmax
+    bounds = G.bounds
+    ga = G.ga
+    gvn = G.gvn
+    pos = P.pos
+    vel = P.vel
+    bad = G.bad
+    buf = G.gbuf[c]
+    buf[0, GM] = 0.0
+    buf[0, GPX] = 0.0
+    buf[0, GPY] = 0.0
+    lo = c * n // nch
+    hi = (c + 1) * n // nch
+    bad[c, 0] = -1
+    conflicts = 0
+    for p in range(lo, hi):
+        r = P.wc[p]
+        i0 = P.wij[p, 0]
+        j0 = P.wij[p, 1]
+        ax = 0.0
+        ay = 0.0
+        vx = 0.0
+        vy = 0.0
+        L00 = 0.0
+        L01 = 0.0
+        L10 = 0.0
+        L11 = 0.0
+        for b in range(NA):
+            sy = r[3 + b]
+            dy = r[9 + b]
+            row = (j0 + b) * nnx + i0
+            for a in range(NA):
+                k = row + a
+                f = field_at(K, p, b * NA + a)
+                s = r[a] * sy
+                ax += s * ga[f, 0, k]
+                ay += s * ga[f, 1, k]
+                vnx = gvn[f, 0, k]
+                vny = gvn[f, 1, k]
+                vx += s * vnx
+                vy += s * vny
+                if dt_stress > 0.0:
                     gx = r[6 + a] * sy
                     gy = r[a] * dy
-                    buf[GFX, k] -= sxx * gx + sxy * gy
-                    buf[GFY, k] -= sxy * gx + syy * gy
+                    L00 += vnx * gx
+                    L01 += vnx * gy
+                    L10 += vny * gx
+                    L11 += vny * gy
+        vmx = vx - ax * dt
+        vmy = vy - ay * dt
+        dvx = (ax - damping * vmx - P.pdamp[p] * vel[0, p]) * dt
+        dvy = (ay - damping * vmy - P.pdamp[p] * vel[1, p]) * dt
+        nvx = vel[0, p] + dvx
+        nvy = vel[1, p] + dvy
+        vel[0, p] = nvx
+        vel[1, p] = nvy
+        x = pos[0, p] + (vmx + 0.5 * dvx) * dt
+        y = pos[1, p] + (vmy + 0.5 * dvy) * dt
+        if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
+            if P.left[p] == 0:
+                P.left[p] = 1
+                bad[c, 2] += 1
+                bad[c, 3] = p
+            x = pos[0, p]
+            y = pos[1, p]
+        pos[0, p] = x
+        pos[1, p] = y
+        if dt_stress > 0.0:
+            _stress_updates(P, S, p, 0.0, dt_stress, L00, L01, L10, L11)
+        if bad[c, 0] < 0:
+            if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
+                    and math.isfinite(y) and math.isfinite(P.stress[0, p])):
+                bad[c, 0] = p
+                bad[c, 1] = STATUS_NONFINITE
+            elif nvx * nvx + nvy * nvy > vmax * vmax:
+                bad[c, 0] = p
+                bad[c, 1] = STATUS_RUNAWAY
+        _store_weights(p, pos, P.lp, geom, idx, idy, P.wij, P.wc)
+        conflicts = _scatter_particle(P, G, K, buf, p, nnx, conflicts)
+    if MULTI_FIELD:
+        K.chunk_counts[c] = conflicts
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def _forces_update(gbuf, g, ga, gvn, dt, mass_tol, nch):
-    nn = g.shape[1]
-    for k in prange(nn):
-        fx = 0.0
-        fy = 0.0
-        for c in range(nch):
-            fx += gbuf[c, GFX, k]
-            fy += gbuf[c, GFY, k]
-        fx = g[GFX, k] + fx
-        fy = g[GFY, k] + fy
-        g[GFX, k] = fx
-        g[GFY, k] = fy
-        m = g[GM, k]
-        if m > mass_tol:
-            ga[0, k] = fx / m
-            ga[1, k] = fy / m
-            gvn[0, k] = (g[GPX, k] + fx * dt) / m
-            gvn[1, k] = (g[GPY, k] + fy * dt) / m
-        else:
-            ga[0, k] = 0.0
-            ga[1, k] = 0.0
-            gvn[0, k] = 0.0
-            gvn[1, k] = 0.0
+@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
+def update_and_extrapolate(P, G, C, K, S):
+    """Grid -> particles (FLIP velocity and position with grid and particle damping,
+    as NairnMPM applies them; the USL- / USAVG- stress update), then each particle's
+    new weights and its mass and momentum back to the grid (the next extrapolation:
+    in every method positions and velocities do not change in between)."""
+    for c in prange(S.nch):
+        _update_chunk(P, G, K, S, np.int64(c))
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy")
-def _update_and_extrapolate(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
-                            plane_stress, geom, ga, gvn, dt, dt_stress, damping,
-                            pdamp, bounds, vmax, left, bad, wij, wc, gbuf, nch):
-    """Grid -> particles (FLIP, positions), then the particles' new weights and their
-    mass and momentum back to the grid (the next extrapolation)."""
-    n = pos.shape[1]
-    nnx = int(geom[4])
-    idx = 1.0 / geom[2]
-    idy = 1.0 / geom[3]
-    for c in prange(nch):
-        buf = gbuf[c]
-        buf[GM] = 0.0
-        buf[GPX] = 0.0
-        buf[GPY] = 0.0
-        lo = c * n // nch
-        hi = (c + 1) * n // nch
-        bad[c, 0] = -1
-        for p in range(lo, hi):
-            r = wc[p]
-            i0 = wij[p, 0]
-            j0 = wij[p, 1]
-            ax = 0.0
-            ay = 0.0
-            vx = 0.0
-            vy = 0.0
-            L00 = 0.0
-            L01 = 0.0
-            L10 = 0.0
-            L11 = 0.0
-            for b in range(NA):
-                sy = r[3 + b]
-                dy = r[9 + b]
-                row = (j0 + b) * nnx + i0
-                for a in range(NA):
-                    k = row + a
-                    s = r[a] * sy
-                    ax += s * ga[0, k]
-                    ay += s * ga[1, k]
-                    vnx = gvn[0, k]
-                    vny = gvn[1, k]
-                    vx += s * vnx
-                    vy += s * vny
-                    if dt_stress > 0.0:
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
-                        L00 += vnx * gx
-                        L01 += vnx * gy
-                        L10 += vny * gx
-                        L11 += vny * gy
-            vmx = vx - ax * dt
-            vmy = vy - ay * dt
-            dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
-            dvy = (ay - damping * vmy - pdamp[p] * vel[1, p]) * dt
-            nvx = vel[0, p] + dvx
-            nvy = vel[1, p] + dvy
-            vel[0, p] = nvx
-            vel[1, p] = nvy
-            x = pos[0, p] + (vmx + 0.5 * dvx) * dt
-            y = pos[1, p] + (vmy + 0.5 * dvy) * dt
-            if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
-                if left[p] == 0:
-                    left[p] = 1
-                    bad[c, 2] += 1
-                    bad[c, 3] = p
-                x = pos[0, p]
-                y = pos[1, p]
-            pos[0, p] = x
-            pos[1, p] = y
-            if dt_stress > 0.0:
-                _stress_update(p, dt_stress, L00, L01, L10, L11, F, stress, hist, w, mat,
-                               mat_params, plane_stress)
-            if bad[c, 0] < 0:
-                if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
-                        and math.isfinite(y) and math.isfinite(stress[0, p])):
-                    bad[c, 0] = p
-                    bad[c, 1] = STATUS_NONFINITE
-                elif nvx * nvx + nvy * nvy > vmax * vmax:
-                    bad[c, 0] = p
-                    bad[c, 1] = STATUS_RUNAWAY
-            # the next extrapolation, from the new position and velocity
-            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
-            m = mass[p]
-            mvx = m * nvx
-            mvy = m * nvy
-            i0 = wij[p, 0]
-            j0 = wij[p, 1]
-            for b in range(NA):
-                sy = r[3 + b]
-                row = (j0 + b) * nnx + i0
-                for a in range(NA):
-                    s = sy * r[a]
-                    k = row + a
-                    buf[GM, k] += s * m
-                    buf[GPX, k] += s * mvx
-                    buf[GPY, k] += s * mvy
+# ---- bookkeeping -----------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def advance_clock(P, G, C, K, S):
+    """The step is taken: the time moves on, and USL+ / USAVG+ carry the last stress
+    half into the next stress pass (it has the same velocity gradient)."""
+    S.clock[CLOCK_T] += S.dt
+    if S.plus:
+        S.clock[CLOCK_PENDING] = S.dt_last
 
 
-@njit(cache=True, error_model="numpy")
-def advance(nsteps, t, dt, method, post_extrapolate, plane_stress,
-            pos, vel, mass, vol0, lp, mat, F, stress, hist, w, pdamp, mat_params,
-            geom, bounds, g, gbuf, gv, ga, gvn, gtmp, damping, mass_tol, vmax, left,
-            leave_limit,
-            gbc_node, gbc_dir, gbc_rec, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
-            rec_style, rec_value, rec_t0, rec_ftime, rec_force, rec_work,
-            sym_out, sym_in, sym_dir, bad, nch):
-    """Run up to ``nsteps`` steps from time ``t`` (ms).
-
-    Every extrapolation after the chunk's first is fused into the particle update:
-    it is the next step's extrapolation in every method (positions and velocities do
-    not change in between), and in USL+/USAVG+ also NairnMPM's post-update one, whose
-    stress update is carried over (``pending``) into the next stress pass, which has
-    the same velocity gradient.  Shape-function weights are computed once per step.
-    Returns (steps done, status, offending particle).  ``rec_force`` holds each
-    condition's force (N) on the last step; ``rec_work`` accumulates its work (mJ).
-    """
-    n = pos.shape[1]
-    pload = np.zeros(pbc_part.size)
-    pos_before = np.zeros(pbc_part.size)
-    wij = np.empty((n, 2), dtype=np.int64)
-    wc = np.empty((n, 12))
-    if method == USF:
-        dt_first = dt
-        dt_last = 0.0
-    elif method == USL:
-        dt_first = 0.0
-        dt_last = dt
-    else:
-        dt_first = 0.5 * dt
-        dt_last = dt - dt_first
-    plus = post_extrapolate and dt_last > 0.0
-    _weights_and_mass(pos, vel, mass, lp, geom, wij, wc, gbuf, nch)
-    _reduce_velocity(gbuf, g, gv, mass_tol, nch)
-    _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value, rec_t0,
-                         rec_ftime, sym_out, sym_in, sym_dir, t)
-    _velocity_at(g, gv, gbc_node, mass_tol)
-    _velocity_at(g, gv, sym_out, mass_tol)
-    pending = 0.0
-    for step in range(nsteps):
-        rec_force[:] = 0.0
-        g[GFX] = 0.0
-        g[GFY] = 0.0
-        _scatter_loads(pos, lp, F, geom, g, pbc_part, pbc_dir, pbc_scale, pbc_face, pbc_rec,
-                       rec_style, rec_value, rec_t0, rec_ftime, rec_force, t, pload)
-        for q in range(pbc_part.size):
-            pos_before[q] = pos[pbc_dir[q], pbc_part[q]]
-        _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params, plane_stress,
-                             geom, wij, wc, gv, gbuf, nch, pending, dt_first, True, n)
-        pending = 0.0
-        _forces_update(gbuf, g, ga, gvn, dt, mass_tol, nch)
-        _velocity_conditions_after(g, geom, ga, gvn, gtmp, gbc_node, gbc_dir, gbc_rec, rec_style,
-                                   rec_value, rec_t0, rec_ftime, rec_force, rec_work,
-                                   sym_out, sym_in, sym_dir, t, dt, mass_tol)
-        _update_and_extrapolate(pos, vel, mass, lp, mat, F, stress, hist, w, mat_params,
-                                plane_stress, geom, ga, gvn, dt,
-                                0.0 if post_extrapolate else dt_last, damping, pdamp,
-                                bounds, vmax, left, bad, wij, wc, gbuf, nch)
-        _load_work(pos, pbc_part, pbc_dir, pload, pos_before, rec_work, pbc_rec)
-        t += dt
-        _reduce_velocity(gbuf, g, gv, mass_tol, nch)
-        _momentum_conditions(g, geom, gbc_node, gbc_dir, gbc_rec, rec_style, rec_value,
-                             rec_t0, rec_ftime, sym_out, sym_in, sym_dir, t)
-        _velocity_at(g, gv, gbc_node, mass_tol)
-        _velocity_at(g, gv, sym_out, mass_tol)
-        if plus:
-            pending = dt_last
-        n_left = 0
-        stop = -1
-        for c in range(nch):
-            if bad[c, 0] >= 0:
-                stop = c
-                break
-            n_left += bad[c, 2]
-        status = STATUS_OK
-        who = -1
-        if stop >= 0:
-            status = bad[stop, 1]
-            who = bad[stop, 0]
-        elif n_left >= leave_limit:
-            for c in range(nch):
-                if bad[c, 2] > 0:
-                    status = STATUS_LEFT_GRID
-                    who = bad[c, 3]
-                    break
-        if status != STATUS_OK or step == nsteps - 1:
-            if pending > 0.0:
-                _stress_force_cached(mass, vol0, mat, F, stress, hist, w, mat_params,
-                                     plane_stress, geom, wij, wc, gv, gbuf, nch, 0.0, pending,
-                                     False, n)
-            if status != STATUS_OK:
-                return step + 1, status, who
-    return nsteps, STATUS_OK, -1
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def check_status(P, G, C, K, S):
+    """The first chunk's bad particle (NaN or runaway), else too many particles that
+    tried to leave the grid, into ``S.status``."""
+    bad = G.bad
+    n_left = 0
+    for c in range(S.nch):
+        if bad[c, 0] >= 0:
+            S.status[0] = bad[c, 1]
+            S.status[1] = bad[c, 0]
+            return
+        n_left += bad[c, 2]
+    if n_left >= S.leave_limit:
+        for c in range(S.nch):
+            if bad[c, 2] > 0:
+                S.status[0] = STATUS_LEFT_GRID
+                S.status[1] = bad[c, 3]
+                return
+    S.status[0] = STATUS_OK

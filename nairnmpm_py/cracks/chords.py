@@ -1,4 +1,4 @@
-"""Crack chords as the grid kernels see them (``core/crack_step_kernels``).
+"""Crack chords as the grid kernels see them (``cracks/crack_lists``, ``cracks/crack_kernels``).
 
 * ``_chord``: the end points of chord k (crack particles k and k+1), an exterior
   crack end extended four chord lengths beyond the edge of the body, so a line from

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .bundle import NR, CrackArrays
 from .geometry import EXTERIOR_END, CrackSet
 from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_intensity,
                         tip_cod, to_mpa_sqrt_m)
@@ -91,7 +92,6 @@ class CrackScene:
         self.counts = np.zeros(4, dtype=np.int64)
         self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
         self.initial_root = {(t.crack, t.end): int(self.pid[self.zone(t)[1]]) for t in self.tips}
-        self.kernels = None
         self.check_steps = 1
         self.growth_log: list[dict] = []
         self.j_conflicts = 0      # J-field particle-node pairs on a crack line (field 0)
@@ -100,11 +100,20 @@ class CrackScene:
         self._subset_age = 0
 
     # ---- kernel side ---------------------------------------------------------------
+    n_rows = NR                      # grid rows per field: the core's and the contact rows
+
+    @property
+    def nf(self) -> int:
+        """Velocity fields per node: 2 with one crack, NairnMPM's 4 with more."""
+        return 2 if self.cracks.n_cracks == 1 else 4
+
+    def envelope_functions(self) -> list[str]:
+        """The traction envelopes the crack tasks dispatch over (law table kind = index)."""
+        return sorted({self.laws[m].envelope_function for m in self.laws})
+
     def prepare(self, sim) -> None:
-        from ..core.kernel_build import load_crack_kernels
-        cs = self.cracks
+        functions = self.envelope_functions()
         used = sorted(self.laws)
-        functions = sorted({self.laws[m].envelope_function for m in used})
         nlaw = len(sim.materials)
         width = 1 + max([len(self.laws[m].param_vector(1)) for m in used]
                         + [len(self.laws[m].param_vector(2)) for m in used
@@ -118,36 +127,41 @@ class CrackScene:
                     par = law.param_vector(mode)
                     table[m, 0] = functions.index(law.envelope_function)
                     table[m, 1:1 + len(par)] = par
-        self.kernels = load_crack_kernels(sim.kernels, functions)
-        self.nf = 2 if cs.n_cracks == 1 else 4
         nn = sim.grid.n_nodes
         n = sim.particles.n
         na = 2 if sim.shape == 0 else 3
-        self.g = np.zeros((self.nf, 10, nn))
-        self.gbuf = np.zeros((sim.nch, self.nf, 10, nn))
-        self.gv = np.zeros((self.nf, 2, nn))
-        self.ga = np.zeros((self.nf, 2, nn))
-        self.gvn = np.zeros((self.nf, 2, nn))
         self.vfld = np.zeros((n, na * na), dtype=np.int8)
         self.cut = np.zeros(n, dtype=np.int8)
-        self.wij = np.zeros((n, 2), dtype=np.int64)
-        self.wc = np.zeros((n, 12))
         self.nslot = np.full((2, nn), -1, dtype=np.int64)
         ncells = (sim.grid.nodes_x - 1) * (sim.grid.nodes_y - 1)
         self.cstart = np.zeros((2, ncells), dtype=np.int64)   # chords of a cell (kernel)
         self.cnear = np.zeros(ncells, dtype=np.uint8)
         self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)    # cells the lists cover
         self.chunk_counts = np.zeros(sim.nch, dtype=np.int64)
+        self.cnodes = np.zeros(nn, dtype=np.int64)             # crack lists (see bundle)
+        self.cnodes_old = np.zeros(nn, dtype=np.int64)
+        self.nlist = np.zeros(3, dtype=np.int64)
+        self._chord_capacity()
         self._kernel_arrays()
-        self.grid_current = False      # the next call must extrapolate
-        self.pend = np.zeros(1)        # USAVG+ stress half carried between calls
-        self.chords_now = np.zeros(0, dtype=np.int64)   # crack lists of the last call
-        self.cxy_now = np.zeros((0, 4))
-        self.cnodes_now = np.zeros(0, dtype=np.int64)
         if self.growing:
             # NairnMPM checks for growth every CFL * cell / wave speed (at least a step)
             prop_time = 0.5 * min(sim.grid.dx, sim.grid.dy) / sim.max_wave_speed()
             self.check_steps = max(1, int(prop_time / sim.dt + 1e-9))
+
+    def _chord_capacity(self) -> None:
+        """Room for the chord-cell entries of the crack lists: a chord of up to a cell
+        with its padding reaches 9 cells, an exterior end's extended chord a few times
+        more, so 64 per crack particle is ample; kept when it already suffices."""
+        need = 64 * self.cracks.plane.shape[1] + 1024
+        if getattr(self, "chords", None) is None or self.chords.size < need:
+            old = getattr(self, "chords", None)
+            self.chords = np.zeros(need, dtype=np.int64)
+            cxy = np.zeros((need, 4))
+            if old is not None:   # the current lists stay valid until the next rebuild
+                used = int(self.nlist[0])
+                self.chords[:used] = old[:used]
+                cxy[:used] = self.cxy[:used]
+            self.cxy = cxy
 
     def _kernel_arrays(self) -> None:
         cs = self.cracks
@@ -163,28 +177,17 @@ class CrackScene:
     def growing(self) -> bool:
         return any(t.criterion is not None for t in self.tips)
 
-    def advance(self, sim, nsteps: int, flush: bool = True):
-        p = sim.particles
-        resume = self.grid_current
-        self.grid_current = True
-        c = sim.cond_arrays
+    def bundle(self, sim) -> CrackArrays:
+        """The crack bundle ``K`` of the step tasks, over the current crack arrays."""
         cs = self.cracks
-        use_position = self.contact_position is not None
-        done, status, who, self.chords_now, self.cxy_now, self.cnodes_now = self.kernels.advance(
-            nsteps, sim.time, sim.dt, sim.method, sim.post_extrapolate, sim.plane_stress,
-            p.pos, p.pos0, p.vel, p.mass, p.vol0, p.lp, p.mat, p.F, p.stress, p.hist, p.w,
-            p.pdamp, sim.mat_params, sim.geom, sim.bounds, self.g, self.gbuf, self.gv,
-            self.ga, self.gvn, sim.gtmp, sim.damping, sim.vmax, sim.left, sim.leave_max,
-            c["gbc_node"], c["gbc_dir"], c["gbc_rec"], c["pbc_part"], c["pbc_dir"],
-            c["pbc_scale"], c["pbc_face"], c["pbc_rec"], c["rec_style"], c["rec_value"], c["rec_t0"],
-            c["rec_ftime"], sim.rec_force, sim.rec_work, sim.sym_out, sim.sym_in, sim.sym_dir,
-            sim.bad, sim.nch, cs.plane, cs.above, cs.below, self.cfirst, self.clast,
-            self.cext0, self.cext1, self.ccrack, self.cfixed, self.claw, self.state, self.hist,
-            self.law1, self.law2, float(sim.grid.thickness), use_position,
-            float(self.contact_position or 0.0), self.vfld, self.cut, self.wij, self.wc, self.nslot,
-            self.cstart, self.cnear, self.cbox, self.counts, self.chunk_counts, resume, flush,
-            self.pend, self.chords_now, self.cxy_now, self.cnodes_now)
-        return done, status, who
+        grid = sim.grid
+        return CrackArrays(
+            cs.plane, cs.above, cs.below, self.cfirst, self.clast, self.cext0, self.cext1,
+            self.ccrack, self.cfixed, self.claw, self.state, self.hist, self.law1, self.law2,
+            self.vfld, self.cut, self.nslot, self.cstart, self.cnear, self.cbox, self.chords,
+            self.cxy, self.cnodes, self.cnodes_old, self.nlist, self.counts, self.chunk_counts,
+            float(grid.thickness), self.contact_position is not None,
+            float(self.contact_position or 0.0), grid.nodes_x - 1, grid.nodes_y - 1)
 
     # ---- zone and traction work -------------------------------------------------------
     def _tip_point(self, tip: Tip) -> np.ndarray:
@@ -456,7 +459,8 @@ class CrackScene:
             # free, as in NairnMPM)
             self.initial_root[(tip.crack, tip.end)] = int(self.pid[at])
         self._kernel_arrays()
-        self.grid_current = False
+        self._chord_capacity()
+        sim.grid_current = False
         return True
 
     def rcurve_theory(self, sim, points: int = 121) -> list[dict]:
@@ -493,3 +497,8 @@ class CrackScene:
                 "surfaces_without_material": int(self.counts[1]),
                 "blocked_crack_moves": int(self.counts[3]),
                 "j_field_conflicts": int(self.j_conflicts)}
+
+
+def propagate(sim) -> list[dict]:
+    """The propagation check of ``core/tasks.PERIODIC``: ``CrackScene.propagate``."""
+    return sim.cracks.propagate(sim)

@@ -15,8 +15,6 @@ from ..core.conditions import GRID_VELOCITY, PARTICLE_LOAD, ConditionRecord, Con
 from ..core.grid import Grid
 from ..core.particles import Particles
 from ..core.shape import LINEAR, UGIMP
-from ..cracks.geometry import CrackSet, polyline_problems
-from ..cracks.scene import CrackScene, Tip
 from ..core.simulation import GlobalQuantity, Simulation
 from .models import AxisModel, BodyModel, ConditionModel, InputModel, ShapeModel
 from .reader import read_input
@@ -103,6 +101,9 @@ class _at:
 
 # ---- cracks -------------------------------------------------------------------------
 def _check_cracks(r: Reader, model: InputModel, grid: Grid) -> None:
+    if not model.cracks:
+        return
+    from ..cracks.geometry import polyline_problems   # only scenes with cracks
     cell = min(grid.dx, grid.dy)
     for crack in model.cracks:
         pts = np.array([(p.x, p.y) for p in crack.points])
@@ -180,6 +181,8 @@ def _crack_scene(r: Reader, model: InputModel, materials: list, names: list):
     and the tips that get J."""
     if not model.cracks:
         return None
+    from ..cracks.geometry import CrackSet   # only scenes with cracks load crack modules
+    from ..cracks.scene import CrackScene, Tip
     polylines, laws, tips, fixed, tip_list, used = [], [], [], [], [], {}
     for c, crack in enumerate(model.cracks):
         polylines.append(np.array([(p.x, p.y) for p in crack.points]))

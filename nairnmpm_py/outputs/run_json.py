@@ -70,6 +70,8 @@ class RunJson(OutputPlugin):
         self.info["exit_status"] = status.get("exit_status", "unknown")
         if status.get("message"):
             self.info["message"] = str(status["message"])
+        if status.get("profile"):
+            self.info["profile"] = status["profile"]
         scene = getattr(sim, "cracks", None)
         if scene is not None:
             self.info["cracks"] = scene.summary()

@@ -1,13 +1,12 @@
-"""Traction dispatch used when ``crack_step_kernels`` is imported directly (cubic only).
+"""Traction dispatch of the crack-task template when imported directly: a stub.
 
 Scenes with traction laws get a generated dispatcher over their laws' envelopes
 instead (see ``core.kernel_build``).
 """
 from numba import njit
 
-from nairnmpm_py.traction.cubic import envelope as _cubic
-
 
 @njit(cache=True, inline="always")
 def traction_envelope(kind, delta, par):
-    return _cubic(delta, par)
+    """No law: no traction."""
+    return 0.0

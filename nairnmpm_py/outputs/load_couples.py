@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .conditions import PARTICLE_LOAD
+from ..core.conditions import PARTICLE_LOAD
 
 
 @dataclass
