@@ -117,7 +117,7 @@ def load_kernels(update_functions: list[str], shape: int = 1,
         crack_names = sorted({t.name for group in step_tasks(True) for t in group
                               if t.module == CRACKS})
         _replace_marked(lines, FIELDS_MARKER,
-                        f"from {cracks.__name__} import assign_and_scatter, "
+                        f"from {cracks.__name__} import assign_and_scatter, field_lists, "
                         + ", ".join(crack_names), where)
         _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
         refs.append(cracks.__name__ + ":x")

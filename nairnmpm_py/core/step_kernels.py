@@ -17,23 +17,27 @@ cracks builds this file with ``MULTI_FIELD`` True and the crack module's
 (``K.vfld``; ``K.cut`` 0 for a particle that touches no crack node); every pass here
 then reads and writes the particle's own field.
 
-Every task and chunk function is compiled without a Python entry point
-(``no_cpython_wrapper``): only the driver calls them, and the unboxing code of five
-bundles would cost about a second of compiling each.
+Every task is compiled without a Python entry point (``no_cpython_wrapper``): only
+the driver calls them, and the unboxing code of five bundles would cost about a
+second of compiling each.
 
 Particle loops run as fixed chunks, each with its own grid buffer, reduced in a fixed
-order: results do not depend on thread scheduling.  A parallel task's ``prange`` body
-only calls the chunk's function with the bundles and an int64 chunk index: Numba 0.68
-loses writes made through a bundle's arrays inside a ``prange`` body itself
-(measured), not through those of a function it calls, and the index would otherwise
-arrive as uint64 in one compile and int64 in another (two compiles of each chunk).  ``FAST`` allows reassociation and
-fused multiply-adds but keeps NaN and infinity semantics, so blow-ups are still caught.
+order: results do not depend on thread scheduling.  A parallel task first takes the
+arrays it needs out of the bundles into plain locals, and its ``prange`` body (and
+the inline helpers it calls) uses only those.  Two reasons, both measured: Numba 0.68
+loses writes made in a ``prange`` body through a named tuple's arrays, also when
+they are unpacked (``a, b = P``) or regrouped into a tuple there (numba#7135,
+numba#10338); and only plain array arguments of the parallel loop are marked as not
+aliasing one another, which the particle loops need to run as fast as with
+positional arrays (through bundles the beam ran 1.6-2.2x slower).
+
+``FAST`` allows reassociation and fused multiply-adds but keeps NaN and infinity
+semantics, so blow-ups are still caught.
 """
 from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from nairnmpm_py.core.grid_ops import accelerate_node
@@ -42,7 +46,7 @@ from nairnmpm_py.core.state import (GM, GPX, GPY, GFX, GFY, CLOCK_T, CLOCK_PENDI
                                     STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY)
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
 from nairnmpm_py.core.expressions import no_condition_function as condition_function  # KERNEL-FUNCTIONS
-from nairnmpm_py.core.single_field import assign_and_scatter  # KERNEL-FIELDS
+from nairnmpm_py.core.single_field import assign_and_scatter, field_lists  # KERNEL-FIELDS
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
 MULTI_FIELD = False  # KERNEL-MULTI-FIELD: more than one velocity field per node
@@ -102,11 +106,12 @@ def particle_rotation(F, p):
 
 
 @njit(cache=True, inline="always")
-def field_at(K, p, slot):
-    """The velocity field particle p uses at the ``slot``-th node of its stencil."""
+def field_at(cut, vfld, p, slot):
+    """The velocity field particle p uses at the ``slot``-th node of its stencil
+    (``K.cut``, ``K.vfld``)."""
     if MULTI_FIELD:
-        if K.cut[p]:
-            return K.vfld[p, slot]
+        if cut[p]:
+            return vfld[p, slot]
     return 0
 
 
@@ -177,7 +182,7 @@ def scatter_loads(P, G, C, K, S):
                 pb = j - P.wij[p, 1]
                 fld = 0
                 if 0 <= pa < NA and 0 <= pb < NA:
-                    fld = field_at(K, p, pb * NA + pa)
+                    fld = field_at(K.cut, K.vfld, p, pb * NA + pa)
                 if g[fld, GM, j * nnx + i] > 0.0:
                     g[fld, row_c, j * nnx + i] += sw * f
             continue
@@ -185,7 +190,7 @@ def scatter_loads(P, G, C, K, S):
         for b in range(NA):
             row = (P.wij[p, 1] + b) * nnx + P.wij[p, 0]
             for a in range(NA):
-                g[field_at(K, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
+                g[field_at(K.cut, K.vfld, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
@@ -344,89 +349,108 @@ def _apply_increment(p, e00, e01, e10, e11, F):
 
 
 @njit(cache=True, inline="always")
-def _stress_updates(P, S, p, dt_pre, dt_stress, L00, L01, L10, L11):
+def _stress_update(p, dt, L00, L01, L10, L11, mat, F, stress, hist, w, mat_params,
+                   plane_stress):
+    """One stress update of particle p over dt with its velocity gradient."""
+    e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt)
+    _apply_increment(p, e00, e01, e10, e11, F)
+    m = mat[p]
+    material_update(m, p, dt, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
+                    plane_stress)
+
+
+@njit(cache=True, inline="always")
+def _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, mat, F, stress, hist, w,
+                    mat_params, plane_stress):
     """The stress updates of one particle with one velocity gradient: a carried-over
     USAVG+ / USL+ update of dt_pre, then this step's of dt_stress (either may be 0).
     USAVG+ has dt_pre = dt_stress = dt/2, so the increment exponential is found once
     and applied twice (the same numbers as two separate updates).  One call site of
     the material update, so its inlined code exists once per pass."""
     e00 = e01 = e10 = e11 = 0.0
-    m = P.mat[p]
+    m = mat[p]
     for i in range(2):
         dt_i = dt_pre if i == 0 else dt_stress
         if dt_i <= 0.0:
             continue
         if i == 0 or dt_pre != dt_stress:
             e00, e01, e10, e11 = _increment_exp(L00, L01, L10, L11, dt_i)
-        _apply_increment(p, e00, e01, e10, e11, P.F)
-        material_update(m, p, dt_i, L00, L01, L10, L11, P.F, P.stress, P.hist, P.w,
-                        S.mat_params[m], S.plane_stress)
+        _apply_increment(p, e00, e01, e10, e11, F)
+        material_update(m, p, dt_i, L00, L01, L10, L11, F, stress, hist, w, mat_params[m],
+                        plane_stress)
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def _stress_chunk(P, G, K, S, c, dt_pre, dt_stress, scatter):
-    """Chunk c of the stress pass: each particle's velocity gradient from its own
-    fields' grid velocities, its stress updates (``_stress_updates``), and with
-    ``scatter`` its internal forces into the same fields of the chunk's buffer."""
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
+    """Each particle's velocity gradient from its own fields' grid velocities, its
+    stress updates (``_stress_updates``), and with ``scatter`` its internal forces
+    into the same fields of its chunk's buffer."""
+    # plain local arrays for the parallel loop (module docstring)
+    vol0 = P.vol0
+    mat = P.mat
+    F = P.F
+    stress = P.stress
+    hist = P.hist
+    w = P.w
+    wij = P.wij
+    wc = P.wc
+    gv = G.gv
+    gbuf = G.gbuf
+    cut = K.cut
+    vfld = K.vfld
+    mat_params = S.mat_params
+    plane_stress = S.plane_stress
     n = P.pos.shape[1]
     nch = S.nch
     nnx = int(G.geom[4])
-    gv = G.gv
-    buf = G.gbuf[c]
-    if scatter:
-        buf[0, GFX] = 0.0
-        buf[0, GFY] = 0.0
-    lo = c * n // nch
-    hi = (c + 1) * n // nch
-    for p in range(lo, hi):
-        r = P.wc[p]
-        i0 = P.wij[p, 0]
-        j0 = P.wij[p, 1]
-        if dt_stress > 0.0 or dt_pre > 0.0:
-            L00 = 0.0
-            L01 = 0.0
-            L10 = 0.0
-            L11 = 0.0
+    for c in prange(nch):
+        buf = gbuf[c]
+        if scatter:
+            buf[0, GFX] = 0.0
+            buf[0, GFY] = 0.0
+        for p in range(c * n // nch, (c + 1) * n // nch):
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            if dt_stress > 0.0 or dt_pre > 0.0:
+                L00 = 0.0
+                L01 = 0.0
+                L10 = 0.0
+                L11 = 0.0
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        f = field_at(cut, vfld, p, b * NA + a)
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        vx = gv[f, 0, k]
+                        vy = gv[f, 1, k]
+                        L00 += vx * gx
+                        L01 += vx * gy
+                        L10 += vy * gx
+                        L11 += vy * gy
+                _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, mat, F, stress, hist,
+                                w, mat_params, plane_stress)
+            if not scatter:
+                continue
+            vol = vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
+            sxx = stress[0, p] * vol
+            syy = stress[1, p] * vol
+            sxy = stress[2, p] * vol
             for b in range(NA):
                 sy = r[3 + b]
                 dy = r[9 + b]
                 row = (j0 + b) * nnx + i0
                 for a in range(NA):
                     k = row + a
-                    f = field_at(K, p, b * NA + a)
+                    f = field_at(cut, vfld, p, b * NA + a)
                     gx = r[6 + a] * sy
                     gy = r[a] * dy
-                    vx = gv[f, 0, k]
-                    vy = gv[f, 1, k]
-                    L00 += vx * gx
-                    L01 += vx * gy
-                    L10 += vy * gx
-                    L11 += vy * gy
-            _stress_updates(P, S, p, dt_pre, dt_stress, L00, L01, L10, L11)
-        if not scatter:
-            continue
-        F = P.F
-        vol = P.vol0[p] * (F[0, p] * F[3, p] - F[1, p] * F[2, p]) * F[4, p]
-        sxx = P.stress[0, p] * vol
-        syy = P.stress[1, p] * vol
-        sxy = P.stress[2, p] * vol
-        for b in range(NA):
-            sy = r[3 + b]
-            dy = r[9 + b]
-            row = (j0 + b) * nnx + i0
-            for a in range(NA):
-                k = row + a
-                f = field_at(K, p, b * NA + a)
-                gx = r[6 + a] * sy
-                gy = r[a] * dy
-                buf[f, GFX, k] -= sxx * gx + sxy * gy
-                buf[f, GFY, k] -= sxy * gx + syy * gy
-
-
-@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
-def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
-    for c in prange(S.nch):
-        _stress_chunk(P, G, K, S, np.int64(c), dt_pre, dt_stress, scatter)
+                    buf[f, GFX, k] -= sxx * gx + sxy * gy
+                    buf[f, GFY, k] -= sxy * gx + syy * gy
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
@@ -548,50 +572,89 @@ def scatter_mass_momentum(b0, r, i0, j0, nnx, m, mvx, mvy):
 
 
 @njit(cache=True, inline="always")
-def _scatter_particle(P, G, K, buf, p, nnx, conflicts):
+def _scatter_particle(buf, p, r, i0, j0, geom, m, x, y, vx, vy, pos0, vfld, cut,
+                      crack_lists, conflicts):
     """Particle p's mass and momentum to the grid: its field choice and crack rows in
-    a multi-field build, else field 0."""
+    a multi-field build (``crack_lists`` from the field module), else field 0."""
     if MULTI_FIELD:
-        return assign_and_scatter(P, G, K, buf, p, conflicts)
-    m = P.mass[p]
-    scatter_mass_momentum(buf[0], P.wc[p], P.wij[p, 0], P.wij[p, 1], nnx, m,
-                          m * P.vel[0, p], m * P.vel[1, p])
+        return assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, m * vx, m * vy, pos0,
+                                  vfld, cut, crack_lists, conflicts)
+    scatter_mass_momentum(buf[0], r, i0, j0, int(geom[4]), m, m * vx, m * vy)
     return conflicts
 
 
-@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def _weights_chunk(P, G, K, S, c):
-    n = P.pos.shape[1]
-    nch = S.nch
-    geom = G.geom
-    nnx = int(geom[4])
-    idx = 1.0 / geom[2]
-    idy = 1.0 / geom[3]
-    buf = G.gbuf[c]
-    buf[0, GM] = 0.0
-    buf[0, GPX] = 0.0
-    buf[0, GPY] = 0.0
-    conflicts = 0
-    for p in range(c * n // nch, (c + 1) * n // nch):
-        _store_weights(p, P.pos, P.lp, geom, idx, idy, P.wij, P.wc)
-        conflicts = _scatter_particle(P, G, K, buf, p, nnx, conflicts)
-    if MULTI_FIELD:
-        K.chunk_counts[c] = conflicts
-
-
-@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def weights_and_mass(P, G, C, K, S):
     """Weights of every particle (cached) and their mass and momentum on the grid."""
-    for c in prange(S.nch):
-        _weights_chunk(P, G, K, S, np.int64(c))
+    # plain local arrays for the parallel loop (module docstring)
+    pos = P.pos
+    pos0 = P.pos0
+    vel = P.vel
+    mass = P.mass
+    lp = P.lp
+    wij = P.wij
+    wc = P.wc
+    geom = G.geom
+    gbuf = G.gbuf
+    vfld = K.vfld
+    cut = K.cut
+    chunk_counts = K.chunk_counts
+    crack_lists = field_lists(K)
+    n = pos.shape[1]
+    nch = S.nch
+    idx = 1.0 / geom[2]
+    idy = 1.0 / geom[3]
+    for c in prange(nch):
+        buf = gbuf[c]
+        buf[0, GM] = 0.0
+        buf[0, GPX] = 0.0
+        buf[0, GPY] = 0.0
+        conflicts = 0
+        for p in range(c * n // nch, (c + 1) * n // nch):
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            conflicts = _scatter_particle(buf, p, wc[p], wij[p, 0], wij[p, 1], geom,
+                                          mass[p], pos[0, p], pos[1, p], vel[0, p], vel[1, p],
+                                          pos0, vfld, cut, crack_lists, conflicts)
+        if MULTI_FIELD:
+            chunk_counts[c] = conflicts
 
 
 # ---- grid -> particles -----------------------------------------------------------------
-@njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def _update_chunk(P, G, K, S, c):
-    n = P.pos.shape[1]
-    nch = S.nch
+@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+def update_and_extrapolate(P, G, C, K, S):
+    """Grid -> particles (FLIP velocity and position with grid and particle damping,
+    as NairnMPM applies them; the USL- / USAVG- stress update), then each particle's
+    new weights and its mass and momentum back to the grid (the next extrapolation:
+    in every method positions and velocities do not change in between)."""
+    # plain local arrays for the parallel loop (module docstring)
+    pos = P.pos
+    pos0 = P.pos0
+    vel = P.vel
+    mass = P.mass
+    lp = P.lp
+    mat = P.mat
+    F = P.F
+    stress = P.stress
+    hist = P.hist
+    w = P.w
+    pdamp = P.pdamp
+    left = P.left
+    wij = P.wij
+    wc = P.wc
     geom = G.geom
+    bounds = G.bounds
+    ga = G.ga
+    gvn = G.gvn
+    gbuf = G.gbuf
+    bad = G.bad
+    vfld = K.vfld
+    cut = K.cut
+    chunk_counts = K.chunk_counts
+    crack_lists = field_lists(K)
+    mat_params = S.mat_params
+    plane_stress = S.plane_stress
+    n = pos.shape[1]
+    nch = S.nch
     nnx = int(geom[4])
     idx = 1.0 / geom[2]
     idy = 1.0 / geom[3]
@@ -599,96 +662,82 @@ def _update_chunk(P, G, K, S, c):
     dt_stress = S.dt_update
     damping = S.damping
     vmax = S.vmax
-    bounds = G.bounds
-    ga = G.ga
-    gvn = G.gvn
-    pos = P.pos
-    vel = P.vel
-    bad = G.bad
-    buf = G.gbuf[c]
-    buf[0, GM] = 0.0
-    buf[0, GPX] = 0.0
-    buf[0, GPY] = 0.0
-    lo = c * n // nch
-    hi = (c + 1) * n // nch
-    bad[c, 0] = -1
-    conflicts = 0
-    for p in range(lo, hi):
-        r = P.wc[p]
-        i0 = P.wij[p, 0]
-        j0 = P.wij[p, 1]
-        ax = 0.0
-        ay = 0.0
-        vx = 0.0
-        vy = 0.0
-        L00 = 0.0
-        L01 = 0.0
-        L10 = 0.0
-        L11 = 0.0
-        for b in range(NA):
-            sy = r[3 + b]
-            dy = r[9 + b]
-            row = (j0 + b) * nnx + i0
-            for a in range(NA):
-                k = row + a
-                f = field_at(K, p, b * NA + a)
-                s = r[a] * sy
-                ax += s * ga[f, 0, k]
-                ay += s * ga[f, 1, k]
-                vnx = gvn[f, 0, k]
-                vny = gvn[f, 1, k]
-                vx += s * vnx
-                vy += s * vny
-                if dt_stress > 0.0:
-                    gx = r[6 + a] * sy
-                    gy = r[a] * dy
-                    L00 += vnx * gx
-                    L01 += vnx * gy
-                    L10 += vny * gx
-                    L11 += vny * gy
-        vmx = vx - ax * dt
-        vmy = vy - ay * dt
-        dvx = (ax - damping * vmx - P.pdamp[p] * vel[0, p]) * dt
-        dvy = (ay - damping * vmy - P.pdamp[p] * vel[1, p]) * dt
-        nvx = vel[0, p] + dvx
-        nvy = vel[1, p] + dvy
-        vel[0, p] = nvx
-        vel[1, p] = nvy
-        x = pos[0, p] + (vmx + 0.5 * dvx) * dt
-        y = pos[1, p] + (vmy + 0.5 * dvy) * dt
-        if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
-            if P.left[p] == 0:
-                P.left[p] = 1
-                bad[c, 2] += 1
-                bad[c, 3] = p
-            x = pos[0, p]
-            y = pos[1, p]
-        pos[0, p] = x
-        pos[1, p] = y
-        if dt_stress > 0.0:
-            _stress_updates(P, S, p, 0.0, dt_stress, L00, L01, L10, L11)
-        if bad[c, 0] < 0:
-            if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
-                    and math.isfinite(y) and math.isfinite(P.stress[0, p])):
-                bad[c, 0] = p
-                bad[c, 1] = STATUS_NONFINITE
-            elif nvx * nvx + nvy * nvy > vmax * vmax:
-                bad[c, 0] = p
-                bad[c, 1] = STATUS_RUNAWAY
-        _store_weights(p, pos, P.lp, geom, idx, idy, P.wij, P.wc)
-        conflicts = _scatter_particle(P, G, K, buf, p, nnx, conflicts)
-    if MULTI_FIELD:
-        K.chunk_counts[c] = conflicts
-
-
-@njit(cache=True, parallel=True, error_model="numpy", no_cpython_wrapper=True)
-def update_and_extrapolate(P, G, C, K, S):
-    """Grid -> particles (FLIP velocity and position with grid and particle damping,
-    as NairnMPM applies them; the USL- / USAVG- stress update), then each particle's
-    new weights and its mass and momentum back to the grid (the next extrapolation:
-    in every method positions and velocities do not change in between)."""
-    for c in prange(S.nch):
-        _update_chunk(P, G, K, S, np.int64(c))
+    for c in prange(nch):
+        buf = gbuf[c]
+        buf[0, GM] = 0.0
+        buf[0, GPX] = 0.0
+        buf[0, GPY] = 0.0
+        bad[c, 0] = -1
+        conflicts = 0
+        for p in range(c * n // nch, (c + 1) * n // nch):
+            r = wc[p]
+            i0 = wij[p, 0]
+            j0 = wij[p, 1]
+            ax = 0.0
+            ay = 0.0
+            vx = 0.0
+            vy = 0.0
+            L00 = 0.0
+            L01 = 0.0
+            L10 = 0.0
+            L11 = 0.0
+            for b in range(NA):
+                sy = r[3 + b]
+                dy = r[9 + b]
+                row = (j0 + b) * nnx + i0
+                for a in range(NA):
+                    k = row + a
+                    f = field_at(cut, vfld, p, b * NA + a)
+                    s = r[a] * sy
+                    ax += s * ga[f, 0, k]
+                    ay += s * ga[f, 1, k]
+                    vnx = gvn[f, 0, k]
+                    vny = gvn[f, 1, k]
+                    vx += s * vnx
+                    vy += s * vny
+                    if dt_stress > 0.0:
+                        gx = r[6 + a] * sy
+                        gy = r[a] * dy
+                        L00 += vnx * gx
+                        L01 += vnx * gy
+                        L10 += vny * gx
+                        L11 += vny * gy
+            vmx = vx - ax * dt
+            vmy = vy - ay * dt
+            dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
+            dvy = (ay - damping * vmy - pdamp[p] * vel[1, p]) * dt
+            nvx = vel[0, p] + dvx
+            nvy = vel[1, p] + dvy
+            vel[0, p] = nvx
+            vel[1, p] = nvy
+            x = pos[0, p] + (vmx + 0.5 * dvx) * dt
+            y = pos[1, p] + (vmy + 0.5 * dvy) * dt
+            if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
+                if left[p] == 0:
+                    left[p] = 1
+                    bad[c, 2] += 1
+                    bad[c, 3] = p
+                x = pos[0, p]
+                y = pos[1, p]
+            pos[0, p] = x
+            pos[1, p] = y
+            if dt_stress > 0.0:
+                _stress_update(p, dt_stress, L00, L01, L10, L11, mat, F, stress, hist, w,
+                               mat_params, plane_stress)
+            if bad[c, 0] < 0:
+                if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
+                        and math.isfinite(y) and math.isfinite(stress[0, p])):
+                    bad[c, 0] = p
+                    bad[c, 1] = STATUS_NONFINITE
+                elif nvx * nvx + nvy * nvy > vmax * vmax:
+                    bad[c, 0] = p
+                    bad[c, 1] = STATUS_RUNAWAY
+            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
+            conflicts = _scatter_particle(buf, p, wc[p], wij[p, 0], wij[p, 1], geom,
+                                          mass[p], x, y, nvx, nvy, pos0, vfld, cut, crack_lists,
+                                          conflicts)
+        if MULTI_FIELD:
+            chunk_counts[c] = conflicts
 
 
 # ---- bookkeeping -----------------------------------------------------------------------

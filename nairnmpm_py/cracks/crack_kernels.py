@@ -108,25 +108,28 @@ def _add_normal(fb, k, w, side, chord, cp):
     fb[GSD, k] += w * side
 
 
+@njit(cache=True)
+def field_lists(K):
+    """The crack lists ``assign_and_scatter`` reads, as a plain tuple the core's
+    parallel loops can take (they cannot take the bundle: module docstring of
+    ``core.step_kernels``)."""
+    return (K.cnear, K.nslot, K.cstart, K.chords, K.cxy, K.ccrack, K.cp, K.ncx, K.ncy,
+            K.use_position)
+
+
 @njit(cache=True, inline="always")
-def assign_and_scatter(P, G, K, buf, p, conflicts):
-    """Field choice at each node of particle p, then its mass and momentum (and at crack
+def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, pos0, vfld, cut,
+                       crack_lists, conflicts):
+    """Field choice at each node of particle p (weights ``r`` from node (i0, j0); mass
+    m at (x, y) with momentum (mvx, mvy)), then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
     side) onto its chunk buffer.  A particle in a cell with no chord within two cells
     (``cnear`` 0) touches no crack node: field 0, no crossing tests, ``cut`` 0."""
-    r = P.wc[p]
-    i0 = P.wij[p, 0]
-    j0 = P.wij[p, 1]
-    geom = G.geom
+    cnear, nslot, cstart, chords, cxy, ccrack, cp, ncx, ncy, use_position = crack_lists
     nnx = int(geom[4])
-    m = P.mass[p]
-    x = P.pos[0, p]
-    y = P.pos[1, p]
-    mvx = m * P.vel[0, p]
-    mvy = m * P.vel[1, p]
-    cell = _cell_of(x, y, geom, K.ncx, K.ncy)
-    if K.cnear[cell] == 0:
-        K.cut[p] = 0
+    cell = _cell_of(x, y, geom, ncx, ncy)
+    if cnear[cell] == 0:
+        cut[p] = 0
         b0 = buf[0]
         for b in range(NA):
             sy = r[3 + b]
@@ -138,14 +141,12 @@ def assign_and_scatter(P, G, K, buf, p, conflicts):
                 b0[GPX, k] += s * mvx
                 b0[GPY, k] += s * mvy
         return conflicts
-    if K.use_position:
+    if use_position:
         mux = m * x
         muy = m * y
     else:
-        mux = m * (x - P.pos0[0, p])
-        muy = m * (y - P.pos0[1, p])
-    nslot = K.nslot
-    cstart = K.cstart
+        mux = m * (x - pos0[0, p])
+        muy = m * (y - pos0[1, p])
     has_chords = cstart[1, cell] > cstart[0, cell]
     nf = buf.shape[0]
     any_cut = 0
@@ -160,15 +161,15 @@ def assign_and_scatter(P, G, K, buf, p, conflicts):
             if slotted and has_chords:
                 xn = geom[0] + (i0 + a) * geom[2]
                 yn = geom[1] + (j0 + b) * geom[3]
-                f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, K.chords,
-                                                     K.cxy, K.ccrack, nslot, nf)
+                f, k0, s0, k1, s1, bad = _pair_field(x, y, xn, yn, k, cell, cstart, chords,
+                                                     cxy, ccrack, nslot, nf)
                 conflicts += bad
                 w = s * m
                 if k0 >= 0:
-                    _add_normal(buf[1], k, w, s0, k0, K.cp)
+                    _add_normal(buf[1], k, w, s0, k0, cp)
                 if k1 >= 0:
-                    _add_normal(buf[2], k, w, s1, k1, K.cp)
-            K.vfld[p, b * NA + a] = f
+                    _add_normal(buf[2], k, w, s1, k1, cp)
+            vfld[p, b * NA + a] = f
             any_cut |= f
             fb = buf[f]
             fb[GM, k] += s * m
@@ -177,7 +178,7 @@ def assign_and_scatter(P, G, K, buf, p, conflicts):
             if slotted:
                 fb[GUX, k] += s * mux
                 fb[GUY, k] += s * muy
-    K.cut[p] = 1 if any_cut else 0
+    cut[p] = 1 if any_cut else 0
     return conflicts
 
 
