@@ -31,6 +31,7 @@ SHAPE_MARKER = "# KERNEL-SHAPE"
 FUNCTIONS_MARKER = "# KERNEL-FUNCTIONS"
 FIELDS_MARKER = "# KERNEL-FIELDS"
 MULTI_FIELD_MARKER = "# KERNEL-MULTI-FIELD"
+UPDATE_STRESS_MARKER = "# KERNEL-UPDATE-STRESS"
 
 
 def cache_dir() -> Path:
@@ -91,12 +92,14 @@ def _replace_marked(lines: list[str], marker: str, text: str, where: str) -> Non
 
 def load_kernels(update_functions: list[str], shape: int = 1,
                  expressions: dict[int, str] | None = None,
-                 crack_envelopes: list[str] | None = None):
+                 crack_envelopes: list[str] | None = None, update_stress: bool = True):
     """(kernel module, condition constants) for a scene whose materials use these
     update functions (in order), with one kind of shape function (0 linear, 1 uGIMP),
     the scene's style-6 condition expressions (record index -> expression of t) and,
     for a scene with cracks, the traction envelopes of its laws ("module:function",
     index = kind in the law tables).  The module's ``advance`` is the step driver.
+    ``update_stress`` False (USF, USL+, USAVG+: the particle update never updates
+    stresses) leaves the material updates out of the particle update's code.
     (A build without Numba's parallel loops for one-thread scenes compiles a third
     faster but ran the beam 2.7x slower on one thread; not used until that is
     understood.)"""
@@ -105,6 +108,9 @@ def load_kernels(update_functions: list[str], shape: int = 1,
     _replace_marked(lines, MARKER, _dispatch_source(update_functions), where)
     _replace_marked(lines, SHAPE_MARKER, f"KIND = {int(shape)}  # shape functions of this build",
                     where)
+    if not update_stress:
+        _replace_marked(lines, UPDATE_STRESS_MARKER, "UPDATE_STRESS = False  # USF / USL+ / USAVG+",
+                        where)
     constants = np.zeros(0)
     if expressions:
         source, constants = condition_module_source(expressions)

@@ -75,6 +75,7 @@ class Simulation:
         self.time = 0.0
         self.step = 0
         self.kernels = None
+        self._update_stress = True  # the kernels built have the particle update's stress update
         self.profiler = None        # a StepProfile while a run is profiled
         self.grid_current = False   # the grid holds the particles' current extrapolation
         self.couples = None    # particle-load groups with a moment column (global row)
@@ -127,7 +128,10 @@ class Simulation:
         expressions = {r: rec.function for r, rec in enumerate(self.conditions.records)
                        if rec.style == 6}
         envelopes = self.cracks.envelope_functions() if self.cracks is not None else None
-        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes)
+        # the particle update updates stresses only in USL- and USAVG-
+        self._update_stress = stress_split(self.method, self.post_extrapolate, 1.0)[2] > 0.0
+        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes,
+                                                 self._update_stress)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
         nf, rows = (self.cracks.nf, self.cracks.n_rows) if self.cracks else (1, N_ROWS)
@@ -222,6 +226,9 @@ class Simulation:
                             self.sym_dir, self.pload, self.pos_before, self.fconst)
         K = self.cracks.bundle(self) if self.cracks is not None else NO_CRACKS
         first, last, update, plus = stress_split(self.method, self.post_extrapolate, self.dt)
+        if update > 0.0 and not self._update_stress:
+            raise RuntimeError("the MPM method changed to USL- / USAVG- after the kernels "
+                               "were built without the particle update's stress update")
         S = Settings(float(self.dt), first, last, update, plus, bool(self.plane_stress),
                      float(self.damping), float(self.mass_tol), float(self.vmax),
                      int(self.leave_max), int(self.nch), self.mat_params, self.clock,

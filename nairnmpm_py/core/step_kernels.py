@@ -50,6 +50,7 @@ from nairnmpm_py.core.single_field import assign_and_scatter, field_lists  # KER
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
 MULTI_FIELD = False  # KERNEL-MULTI-FIELD: more than one velocity field per node
+UPDATE_STRESS = True  # KERNEL-UPDATE-STRESS: the particle update updates stresses (USL- / USAVG-)
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
 FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
 
@@ -64,7 +65,7 @@ def bc_active(style, t0, t):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def bc_value(C, r, t, x, y, q):
     """Value of boundary condition record r at time t (ms).
 
@@ -584,48 +585,11 @@ def _scatter_particle(buf, p, r, i0, j0, geom, m, x, y, vx, vy, pos0, vfld, cut,
 
 
 @njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def weights_and_mass(P, G, C, K, S):
-    """Weights of every particle (cached) and their mass and momentum on the grid."""
-    # plain local arrays for the parallel loop (module docstring)
-    pos = P.pos
-    pos0 = P.pos0
-    vel = P.vel
-    mass = P.mass
-    lp = P.lp
-    wij = P.wij
-    wc = P.wc
-    geom = G.geom
-    gbuf = G.gbuf
-    vfld = K.vfld
-    cut = K.cut
-    chunk_counts = K.chunk_counts
-    crack_lists = field_lists(K)
-    n = pos.shape[1]
-    nch = S.nch
-    idx = 1.0 / geom[2]
-    idy = 1.0 / geom[3]
-    for c in prange(nch):
-        buf = gbuf[c]
-        buf[0, GM] = 0.0
-        buf[0, GPX] = 0.0
-        buf[0, GPY] = 0.0
-        conflicts = 0
-        for p in range(c * n // nch, (c + 1) * n // nch):
-            _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
-            conflicts = _scatter_particle(buf, p, wc[p], wij[p, 0], wij[p, 1], geom,
-                                          mass[p], pos[0, p], pos[1, p], vel[0, p], vel[1, p],
-                                          pos0, vfld, cut, crack_lists, conflicts)
-        if MULTI_FIELD:
-            chunk_counts[c] = conflicts
-
-
-# ---- grid -> particles -----------------------------------------------------------------
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def update_and_extrapolate(P, G, C, K, S):
-    """Grid -> particles (FLIP velocity and position with grid and particle damping,
-    as NairnMPM applies them; the USL- / USAVG- stress update), then each particle's
-    new weights and its mass and momentum back to the grid (the next extrapolation:
-    in every method positions and velocities do not change in between)."""
+def _particle_pass(P, G, K, S, move):
+    """With ``move``: grid -> particles (FLIP velocity and position with grid and
+    particle damping, as NairnMPM applies them; the USL- / USAVG- stress update).
+    Then, in both cases, each particle's weights (cached) and its mass and momentum
+    to the grid.  One function for both: a parallel loop costs seconds to compile."""
     # plain local arrays for the parallel loop (module docstring)
     pos = P.pos
     pos0 = P.pos0
@@ -670,74 +634,96 @@ def update_and_extrapolate(P, G, C, K, S):
         bad[c, 0] = -1
         conflicts = 0
         for p in range(c * n // nch, (c + 1) * n // nch):
-            r = wc[p]
-            i0 = wij[p, 0]
-            j0 = wij[p, 1]
-            ax = 0.0
-            ay = 0.0
-            vx = 0.0
-            vy = 0.0
-            L00 = 0.0
-            L01 = 0.0
-            L10 = 0.0
-            L11 = 0.0
-            for b in range(NA):
-                sy = r[3 + b]
-                dy = r[9 + b]
-                row = (j0 + b) * nnx + i0
-                for a in range(NA):
-                    k = row + a
-                    f = field_at(cut, vfld, p, b * NA + a)
-                    s = r[a] * sy
-                    ax += s * ga[f, 0, k]
-                    ay += s * ga[f, 1, k]
-                    vnx = gvn[f, 0, k]
-                    vny = gvn[f, 1, k]
-                    vx += s * vnx
-                    vy += s * vny
+            if move:
+                r = wc[p]
+                i0 = wij[p, 0]
+                j0 = wij[p, 1]
+                ax = 0.0
+                ay = 0.0
+                vx = 0.0
+                vy = 0.0
+                L00 = 0.0
+                L01 = 0.0
+                L10 = 0.0
+                L11 = 0.0
+                for b in range(NA):
+                    sy = r[3 + b]
+                    dy = r[9 + b]
+                    row = (j0 + b) * nnx + i0
+                    for a in range(NA):
+                        k = row + a
+                        f = field_at(cut, vfld, p, b * NA + a)
+                        s = r[a] * sy
+                        ax += s * ga[f, 0, k]
+                        ay += s * ga[f, 1, k]
+                        vnx = gvn[f, 0, k]
+                        vny = gvn[f, 1, k]
+                        vx += s * vnx
+                        vy += s * vny
+                        if dt_stress > 0.0:
+                            gx = r[6 + a] * sy
+                            gy = r[a] * dy
+                            L00 += vnx * gx
+                            L01 += vnx * gy
+                            L10 += vny * gx
+                            L11 += vny * gy
+                vmx = vx - ax * dt
+                vmy = vy - ay * dt
+                dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
+                dvy = (ay - damping * vmy - pdamp[p] * vel[1, p]) * dt
+                nvx = vel[0, p] + dvx
+                nvy = vel[1, p] + dvy
+                vel[0, p] = nvx
+                vel[1, p] = nvy
+                x = pos[0, p] + (vmx + 0.5 * dvx) * dt
+                y = pos[1, p] + (vmy + 0.5 * dvy) * dt
+                if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
+                    if left[p] == 0:
+                        left[p] = 1
+                        bad[c, 2] += 1
+                        bad[c, 3] = p
+                    x = pos[0, p]
+                    y = pos[1, p]
+                pos[0, p] = x
+                pos[1, p] = y
+                if UPDATE_STRESS:   # a build constant: the update's inlined code only where used
                     if dt_stress > 0.0:
-                        gx = r[6 + a] * sy
-                        gy = r[a] * dy
-                        L00 += vnx * gx
-                        L01 += vnx * gy
-                        L10 += vny * gx
-                        L11 += vny * gy
-            vmx = vx - ax * dt
-            vmy = vy - ay * dt
-            dvx = (ax - damping * vmx - pdamp[p] * vel[0, p]) * dt
-            dvy = (ay - damping * vmy - pdamp[p] * vel[1, p]) * dt
-            nvx = vel[0, p] + dvx
-            nvy = vel[1, p] + dvy
-            vel[0, p] = nvx
-            vel[1, p] = nvy
-            x = pos[0, p] + (vmx + 0.5 * dvx) * dt
-            y = pos[1, p] + (vmy + 0.5 * dvy) * dt
-            if x < bounds[0] or x >= bounds[1] or y < bounds[2] or y >= bounds[3]:
-                if left[p] == 0:
-                    left[p] = 1
-                    bad[c, 2] += 1
-                    bad[c, 3] = p
+                        _stress_update(p, dt_stress, L00, L01, L10, L11, mat, F, stress, hist, w,
+                                       mat_params, plane_stress)
+                if bad[c, 0] < 0:
+                    if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
+                            and math.isfinite(y) and math.isfinite(stress[0, p])):
+                        bad[c, 0] = p
+                        bad[c, 1] = STATUS_NONFINITE
+                    elif nvx * nvx + nvy * nvy > vmax * vmax:
+                        bad[c, 0] = p
+                        bad[c, 1] = STATUS_RUNAWAY
+            else:
                 x = pos[0, p]
                 y = pos[1, p]
-            pos[0, p] = x
-            pos[1, p] = y
-            if dt_stress > 0.0:
-                _stress_update(p, dt_stress, L00, L01, L10, L11, mat, F, stress, hist, w,
-                               mat_params, plane_stress)
-            if bad[c, 0] < 0:
-                if not (math.isfinite(nvx) and math.isfinite(nvy) and math.isfinite(x)
-                        and math.isfinite(y) and math.isfinite(stress[0, p])):
-                    bad[c, 0] = p
-                    bad[c, 1] = STATUS_NONFINITE
-                elif nvx * nvx + nvy * nvy > vmax * vmax:
-                    bad[c, 0] = p
-                    bad[c, 1] = STATUS_RUNAWAY
+                nvx = vel[0, p]
+                nvy = vel[1, p]
             _store_weights(p, pos, lp, geom, idx, idy, wij, wc)
             conflicts = _scatter_particle(buf, p, wc[p], wij[p, 0], wij[p, 1], geom,
                                           mass[p], x, y, nvx, nvy, pos0, vfld, cut, crack_lists,
                                           conflicts)
         if MULTI_FIELD:
             chunk_counts[c] = conflicts
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def weights_and_mass(P, G, C, K, S):
+    """Weights of every particle (cached) and their mass and momentum on the grid."""
+    _particle_pass(P, G, K, S, S.nch < 0)   # a runtime False (see flush_stress)
+
+
+# ---- grid -> particles -----------------------------------------------------------------
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def update_and_extrapolate(P, G, C, K, S):
+    """Grid -> particles, then each particle's new weights and its mass and momentum
+    back to the grid (the next extrapolation: in every method positions and
+    velocities do not change in between)."""
+    _particle_pass(P, G, K, S, S.nch > 0)   # a runtime True
 
 
 # ---- bookkeeping -----------------------------------------------------------------------

@@ -511,9 +511,11 @@ def _side_nodes(k, side, sx, sy, ux, uy, G, K, scratch):
     if total < 0.0:
         total = _surface_nodes(sx, sy, ux, uy, sgn, G, K, scratch)
         if side == 0:
-            scratch[4][:] = scratch[0]
-            scratch[5][:] = scratch[1]
-            scratch[6][:] = scratch[3]
+            # element by element: a slice copy compiles Numba's broadcasting (seconds)
+            for q in range(4):
+                scratch[4][q] = scratch[0][q]
+                scratch[5][q] = scratch[1][q]
+                scratch[6][q] = scratch[3][q]
     return total
 
 
