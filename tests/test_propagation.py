@@ -123,3 +123,25 @@ def test_run_json_carries_the_R_curve_theory(tmp_path):
     d, R = np.array(th["cod_mm"]), np.array(th["R_J_m2"])
     assert d[-1] == pytest.approx(1.2 * 0.04)
     np.testing.assert_allclose(R, R_triangular(d, JIC, 100.0, 0.04, 0.225926299 * 0.04), rtol=1e-9)
+
+
+def test_J_after_a_growth_reads_the_assignment_of_the_grown_crack(tmp_path):
+    """The step's crack-side assignment is for the crack before it grew: J must not read
+    it stale.  After a growth the scene extrapolates again, and J's fields equal those
+    of the standalone crossing test on the grown crack."""
+    from nairnmpm_py.cracks.jintegral import StepAssignment, nodal_fields, step_nodal_fields
+    sim = run(sent_growing(tmp_path, tprop=False, t_end=0.02))
+    scene = sim.cracks
+    window = scene._contour_window(sim, scene.tips, scene.jcontour_size)
+    assert sim.grid_current
+    assert scene._grow(sim, scene.tips[0])
+    assert not sim.grid_current
+    P, G, _, K, _ = sim.bundles()
+    stale = step_nodal_fields(sim.grid, P, StepAssignment(K.vfld, K.cut, K.nslot, G.g, P.wij,
+                                                          P.wc), sim.shape, window=window)
+    fresh = scene.j_fields(sim, window)
+    assert sim.grid_current
+    crossing = nodal_fields(sim.grid, sim.particles, scene.cracks, sim.shape, window=window)
+    assert np.allclose(fresh.mass, crossing.mass, rtol=1e-12, atol=0.0)
+    assert np.array_equal(fresh.crack, crossing.crack)
+    assert not np.allclose(stale.mass, crossing.mass, rtol=1e-12, atol=0.0)

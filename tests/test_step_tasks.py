@@ -78,13 +78,6 @@ def _jitted_functions(path: Path):
             yield node
 
 
-# the J contour still has its own particle-to-grid transfer and crossing tests; it is
-# to read the step's field assignment instead (issue 11's "one crack-side assignment"),
-# which removes both walls.  Listed so that no new wall can appear meanwhile.
-J_CONTOUR_WALLS = ["nairnmpm_py/cracks/jintegral.py _extrapolate (31)",
-                   "nairnmpm_py/cracks/jintegral.py _contour_j (24)"]
-
-
 def test_no_jitted_function_takes_more_than_16_parameters():
     walls = []
     for path in PACKAGE.rglob("*.py"):
@@ -92,7 +85,7 @@ def test_no_jitted_function_takes_more_than_16_parameters():
             n = len(fn.args.args) + len(fn.args.kwonlyargs)
             if n > 16:
                 walls.append(f"{path.relative_to(ROOT)} {fn.name} ({n})")
-    assert sorted(walls) == sorted(J_CONTOUR_WALLS)
+    assert walls == []
 
 
 def test_core_imports_nothing_concrete():

@@ -19,7 +19,6 @@ to the next particle (``root_edge``), where W_B(root) and the root's opening are
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,8 +26,8 @@ from numba import njit
 
 from .bundle import NR, CrackArrays
 from .geometry import EXTERIOR_END, CrackSet
-from .jintegral import (N_PER_MM_TO_J_PER_M2, j_integral, nodal_fields, stress_intensity,
-                        tip_cod, to_mpa_sqrt_m)
+from .jintegral import (N_PER_MM_TO_J_PER_M2, NodalFields, StepAssignment, j_integral,
+                        step_nodal_fields, stress_intensity, tip_cod, to_mpa_sqrt_m)
 
 INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
 NO_MODE = -1.0
@@ -94,7 +93,6 @@ class CrackScene:
         self.initial_root = {(t.crack, t.end): int(self.pid[self.zone(t)[1]]) for t in self.tips}
         self.check_steps = 1
         self.growth_log: list[dict] = []
-        self.j_conflicts = 0      # J-field particle-node pairs on a crack line (field 0)
         self._subset = np.zeros(0, dtype=np.int64)   # particles near the J window
         self._subset_window = None
         self._subset_age = 0
@@ -296,19 +294,25 @@ class CrackScene:
         if not tips:
             return []
         self.update_edge_history()
-        with warnings.catch_warnings():
-            # nodes or particles on a crack line: counted, reported in run.json
-            warnings.simplefilter("ignore", RuntimeWarning)
-            window = self._contour_window(sim, tips, max(sizes))
-            fields = nodal_fields(sim.grid, sim.particles, self.cracks, sim.shape,
-                                  strict=False, window=window,
-                                  subset=self._window_particles(sim, window))
-        self.j_conflicts += fields.conflicts
+        fields = self.j_fields(sim, self._contour_window(sim, tips, max(sizes)))
         rows = []
         for tip in tips:
             for size in sizes:
                 rows.append(self._tip_row(sim, fields, tip, int(size)))
         return rows
+
+    def j_fields(self, sim, window) -> NodalFields:
+        """J's nodal fields over ``window`` with the crack sides the time step assigned.
+        The step assigns them at the end of every step; when the grid is not current
+        (a crack grew at the propagation check just before, or the particles were
+        changed) the assignment is for the old cracks, so the particles are
+        extrapolated again first, as the next step would do anyway."""
+        if not sim.grid_current:
+            sim.advance(0, flush=False)
+        P, G, _, K, _ = sim.bundles()
+        step = StepAssignment(K.vfld, K.cut, K.nslot, G.g, P.wij, P.wc)
+        return step_nodal_fields(sim.grid, P, step, sim.shape, strict=False, window=window,
+                                 subset=self._window_particles(sim, window))
 
     def _contour_window(self, sim, tips, size: int) -> tuple[int, int, int, int]:
         """Real-grid node columns and rows (inclusive) holding the contours of
@@ -495,8 +499,7 @@ class CrackScene:
                 "propagation_check_steps": int(self.check_steps),
                 "field_conflicts": int(self.counts[0]),
                 "surfaces_without_material": int(self.counts[1]),
-                "blocked_crack_moves": int(self.counts[3]),
-                "j_field_conflicts": int(self.j_conflicts)}
+                "blocked_crack_moves": int(self.counts[3])}
 
 
 def propagate(sim) -> list[dict]:
