@@ -9,11 +9,11 @@ from numba import njit
 
 
 @njit(cache=True)
-def field_lists(K):
+def field_lists(P, K):
     return 0
 
 
 @njit(cache=True, inline="always")
-def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, pos0, vfld, cut,
+def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cnear,
                        crack_lists, conflicts):
     return conflicts

@@ -4,8 +4,8 @@ Numba passes a named tuple of arrays to a ``cache=True`` kernel as cheaply as th
 arrays themselves, so each task has the one signature ``task(P, G, C, K, S)``
 instead of dozens of positional arrays.  ``K`` is the crack bundle of a scene with
 cracks (``cracks.bundle``) or ``NO_CRACKS`` here; the core reads only its field
-choice (``vfld``, ``cut``, ``chunk_counts``), and only in builds with more than one
-velocity field.
+choice (``vfld``, ``cut``, ``chunk_counts``, and ``cnear``: cells near a crack), and
+only in builds with more than one velocity field.
 
 Grid arrays carry a field axis: ``g[field, row, node]``.  A scene without cracks
 has one field and the five rows below; a scene with cracks has NairnMPM's up to
@@ -67,9 +67,9 @@ Settings = namedtuple("Settings", [
     "status",          # (2,) status code, particle
 ])
 
-NoCracks = namedtuple("NoCracks", ["vfld", "cut", "chunk_counts"])
+NoCracks = namedtuple("NoCracks", ["vfld", "cut", "chunk_counts", "cnear"])
 NO_CRACKS = NoCracks(np.zeros((0, 0), dtype=np.int8), np.zeros(0, dtype=np.int8),
-                     np.zeros(0, dtype=np.int64))
+                     np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.uint8))
 
 
 def stress_split(method: int, post_extrapolate: bool, dt: float):

@@ -109,25 +109,25 @@ def _add_normal(fb, k, w, side, chord, cp):
 
 
 @njit(cache=True)
-def field_lists(K):
-    """The crack lists ``assign_and_scatter`` reads, as a plain tuple the core's
-    parallel loops can take (they cannot take the bundle: module docstring of
-    ``core.step_kernels``)."""
-    return (K.cnear, K.nslot, K.cstart, K.chords, K.cxy, K.ccrack, K.cp, K.ncx, K.ncy,
-            K.use_position)
+def field_lists(P, K):
+    """What ``assign_and_scatter`` reads for a particle near a crack, as a plain tuple
+    the core's parallel loops can take (not the bundles: module docstring of
+    ``core.step_kernels``).  Reading an array out of a tuple costs reference counting
+    each time, so the test every particle makes (``K.cnear``) is not in it."""
+    return (K.nslot, K.cstart, K.chords, K.cxy, K.ccrack, K.cp, K.use_position, P.pos0)
 
 
 @njit(cache=True, inline="always")
-def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, pos0, vfld, cut,
+def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cnear,
                        crack_lists, conflicts):
     """Field choice at each node of particle p (weights ``r`` from node (i0, j0); mass
     m at (x, y) with momentum (mvx, mvy)), then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
     side) onto its chunk buffer.  A particle in a cell with no chord within two cells
     (``cnear`` 0) touches no crack node: field 0, no crossing tests, ``cut`` 0."""
-    cnear, nslot, cstart, chords, cxy, ccrack, cp, ncx, ncy, use_position = crack_lists
     nnx = int(geom[4])
-    cell = _cell_of(x, y, geom, ncx, ncy)
+    ncx = nnx - 1               # cells per row (``CrackScene``)
+    cell = _cell_of(x, y, geom, ncx, cnear.size // ncx)
     if cnear[cell] == 0:
         cut[p] = 0
         b0 = buf[0]
@@ -141,6 +141,7 @@ def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, pos0, vfld, c
                 b0[GPX, k] += s * mvx
                 b0[GPY, k] += s * mvy
         return conflicts
+    nslot, cstart, chords, cxy, ccrack, cp, use_position, pos0 = crack_lists
     if use_position:
         mux = m * x
         muy = m * y
