@@ -24,12 +24,12 @@ second of compiling each.
 Particle loops run as fixed chunks, each with its own grid buffer, reduced in a fixed
 order: results do not depend on thread scheduling.  A parallel task first takes the
 arrays it needs out of the bundles into plain locals, and its ``prange`` body (and
-the inline helpers it calls) uses only those.  Two reasons, both measured: Numba 0.68
+the inline helpers it calls) uses only those.  Both reasons measured: Numba 0.68
 loses writes made in a ``prange`` body through a named tuple's arrays, also when
 they are unpacked (``a, b = P``) or regrouped into a tuple there (numba#7135,
-numba#10338); and only plain array arguments of the parallel loop are marked as not
-aliasing one another, which the particle loops need to run as fast as with
-positional arrays (through bundles the beam ran 1.6-2.2x slower).
+numba#10338); and a body that calls a function taking the bundles ran the beam
+1.6-2.2x slower.  Reading an array out of a tuple costs reference counting at each
+access, so nothing a particle loop reads for every particle comes from a tuple.
 
 ``FAST`` allows reassociation and fused multiply-adds but keeps NaN and infinity
 semantics, so blow-ups are still caught.
