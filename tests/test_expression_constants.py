@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 from nairnmpm_py.core.conditions import EXPRESSION_FUNCTIONS, evaluate_expression
-from nairnmpm_py.core.expressions import (MAX_LITERAL_EXPONENT, condition_module_source,
-                                          no_condition_function)
+from numba import njit
+
+from nairnmpm_py.core.expressions import (MAX_LITERAL_EXPONENT, call_condition,
+                                          condition_module_source)
 
 RTOL = 1e-14
 
@@ -62,10 +64,16 @@ def _close(got: float, want: float) -> bool:
 
 
 @pytest.fixture(scope="module")
-def compiled(tmp_path_factory):
+def compiled_module(tmp_path_factory):
     expressions = dict(enumerate(EXPRESSIONS))
     source, constants = condition_module_source(expressions)
     module = _load(tmp_path_factory.mktemp("expr"), source, "expr_constants_all")
+    return expressions, constants, module
+
+
+@pytest.fixture(scope="module")
+def compiled(compiled_module):
+    expressions, constants, module = compiled_module
     return expressions, constants, module.condition_function
 
 
@@ -89,7 +97,23 @@ def test_unknown_record_is_zero(compiled):
     _, constants, fn = compiled
     for r in (-1, len(EXPRESSIONS), 99):
         assert fn(r, 0.5, 1.0, 2.0, 0.3, constants) == 0.0
-    assert no_condition_function(0, 0.5, 1.0, 2.0, 0.3, constants) == 0.0
+
+
+@njit
+def _through_address(address, r, t, x, y, q, c):
+    return call_condition(address, r, t, x, y, q, c)
+
+
+def test_kernels_get_the_same_values_through_the_cfunc_address(compiled_module):
+    # the step kernels call the expressions only this way (a runtime address), so
+    # their own source never depends on the expressions
+    expressions, constants, module = compiled_module
+    fn, address = module.condition_function, module.condition_cfunc.address
+    for (r, text), (t, x, y, q) in itertools.product(expressions.items(), POINTS):
+        got = _through_address(address, r, t, x, y, q, constants)
+        assert got == fn(r, t, x, y, q, constants) or (math.isnan(got) and math.isnan(
+            fn(r, t, x, y, q, constants))), (text, (t, x, y, q))
+    assert _through_address(address, 99, 0.5, 1.0, 2.0, 0.3, constants) == 0.0
 
 
 # --- the source depends on the structure only -------------------------------------

@@ -38,6 +38,9 @@ def test_function_styles_match_built_in_styles(tmp_path):
     load_col = [c for c in ref.rows[0] if c.startswith("load_N_") and c.endswith("_x")][-1]
     assert np.allclose(fn.column(load_col), ref.column(load_col))
     assert np.allclose(fn_sim.particles.pos, ref_sim.particles.pos, rtol=0, atol=1e-12)
+    # the expressions are a module of their own, called through its address: the scene
+    # with them runs the very step kernels of the scene without (nothing recompiled)
+    assert fn_sim.kernels is ref_sim.kernels
 
 
 def test_expression_language():

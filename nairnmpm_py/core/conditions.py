@@ -11,7 +11,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 GRID_VELOCITY = "velocity"
 PARTICLE_LOAD = "load"
@@ -29,12 +28,6 @@ class ConditionRecord:
     n_members: int = 0
     function: str | None = None   # style 6: expression of t (ms since t0)
     shape_line: int = 0   # input line of the BCLine/BCPt/LdRect that selected the members
-
-
-@njit(cache=True, inline="always")
-def no_condition_function(r, t, x, y, q):
-    """Stand-in when a scene has no style-6 condition (the kernels get a generated one)."""
-    return 0.0
 
 
 # what a style-6 expression may use (NairnMPM's expression language): t in ms since

@@ -1,16 +1,23 @@
 """Style-6 condition expressions as a cacheable Numba function plus runtime constants.
 
 A scene's style-6 boundary conditions each carry a NairnMPM expression of t, x, y
-and q (see ``conditions.expression_source``).  The kernels call them through one
-generated function ``condition_function(r, t, x, y, q, c)`` whose branch ``r`` is the
-expression of record r.  Numba caches compiled code by source file, so the numeric
-literals of the expressions are *not* written into that source: each becomes
-``c[i]``, an entry of a float64 vector passed at run time.  Two scenes whose
-expressions differ only in their numbers (say a loading rate entity substituted into
-``function="&rate;*t^2"``) then produce the same source and share one compiled
-kernel.
+and q (see ``conditions.expression_source``).  They become one generated module with
+``condition_function(r, t, x, y, q, c)``, whose branch ``r`` is the expression of
+record r, and a C-callable ``condition_cfunc`` around it.  The step kernels call
+the cfunc through its address (``call_condition``, a runtime number in the
+conditions bundle), never by name: the kernels' source, and with it their compiled
+cache, is then the same for every expression, and a scene that differs from a
+compiled one only in its expressions compiles just the small expression module
+(about a second) instead of the step (a minute or more).  The indirect call costs a
+few nanoseconds per evaluation, next to tens for a ``cos``.
 
-What stays in the source, because it changes the code Numba generates:
+Numba also caches that module by its source, so the numeric literals of the
+expressions are *not* written into it: each becomes ``c[i]``, an entry of a float64
+vector passed at run time.  Two scenes whose expressions differ only in their
+numbers (say a loading rate entity substituted into ``function="&rate;*t^2"``) then
+produce the same source and compile nothing at all.
+
+What stays in the expression module's source, because it changes the code:
 
 * the structure of each expression (operators, functions, variables, nesting);
 * small integer exponents of a power (``t^2``, ``t**-3``: an integer literal, with
@@ -29,7 +36,9 @@ from __future__ import annotations
 import ast
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 
 from .conditions import expression_source
 
@@ -41,16 +50,32 @@ MAX_LITERAL_EXPONENT = 8
 CONSTANTS_NAME = "c"
 MATH_ALIAS = "_math_fn"
 NJIT_ALIAS = "_njit_fn"
+CFUNC_ALIAS = "_cfunc_fn"
+CARRAY_ALIAS = "_carray_fn"
+# C signature of ``condition_cfunc``: (r, t, x, y, q, constants pointer, their count)
+CFUNC_SIGNATURE = "float64(int64, float64, float64, float64, float64, CPointer(float64), int64)"
 # math functions whose Numba result is an integer; the generated code makes it a float
 INTEGER_FUNCTIONS = {"floor", "ceil"}
 # the decorator of the generated function (see condition_module_source on inlining)
 DECORATOR = f"@{NJIT_ALIAS}(cache=True, error_model='numpy')"
 
 
-@njit(cache=True, inline="always")
-def no_condition_function(r, t, x, y, q, c):
-    """Stand-in when a scene has no style-6 condition (the kernels get a generated one)."""
-    return 0.0
+@intrinsic
+def call_condition(typingctx, address, r, t, x, y, q, c):
+    """``condition_cfunc(r, t, x, y, q, c)`` of the module whose cfunc is at
+    ``address`` (an int64 from ``condition_functions``); ``c`` a float64 array."""
+    sig = types.float64(types.int64, types.int64, types.float64, types.float64,
+                        types.float64, types.float64, c)
+
+    def codegen(context, builder, signature, args):
+        address, r, t, x, y, q, c = args
+        constants = context.make_array(signature.args[6])(context, builder, c)
+        double, int64 = ir.DoubleType(), ir.IntType(64)
+        fnty = ir.FunctionType(double, [int64, double, double, double, double,
+                                        double.as_pointer(), int64])
+        function = builder.inttoptr(address, fnty.as_pointer())
+        return builder.call(function, [r, t, x, y, q, constants.data, constants.nitems])
+    return sig, codegen
 
 
 def _is_number(value) -> bool:
@@ -135,28 +160,30 @@ def parametrized_expression(text: str, constants: list[float]) -> str:
 
 
 def condition_module_source(expressions: dict[int, str]) -> tuple[str, np.ndarray]:
-    """(source, constants) of ``condition_function(r, t, x, y, q, c)``.
+    """(source, constants) of a module with ``condition_function(r, t, x, y, q, c)``
+    and the kernels' entry ``condition_cfunc`` (signature ``CFUNC_SIGNATURE``).
 
-    ``expressions`` maps record index -> NairnMPM expression.  The source (imports
-    and one jitted function, ready to be written into a module or spliced into the
-    kernel template) returns the expression of record r, or 0.0 for any other r; it
-    depends only on the expressions' structure, not on their numbers.  ``constants``
-    (float64, C-contiguous, possibly empty) is the ``c`` to pass: numbered across the
-    records in increasing record order, and within one in reading order.
+    ``expressions`` maps record index -> NairnMPM expression.  The function returns
+    the expression of record r, or 0.0 for any other r; the source depends only on
+    the expressions' structure, not on their numbers.  ``constants`` (float64,
+    C-contiguous, possibly empty) is the ``c`` to pass: numbered across the records in
+    increasing record order, and within one in reading order.
 
-    The function is not ``inline='always'``: it is compiled once and called, so its
-    compile cost does not repeat at every call site of ``bc_value`` (inlining saves
-    about 10 ns per evaluation, nothing next to a step), and the expression keeps
-    plain IEEE semantics even if a caller is compiled with ``fastmath``.  Its
-    ``error_model='numpy'`` is the callers': a division by zero gives inf or NaN (caught
-    by the kernels' status check), as when the expression was inlined into them."""
+    The expressions keep plain IEEE semantics (the kernels' ``fastmath`` does not
+    reach them).  ``error_model='numpy'`` is the kernels': a division by zero gives
+    inf or NaN, which the kernels' status check catches."""
     constants: list[float] = []
-    lines = [f"import math as {MATH_ALIAS}", f"from numba import njit as {NJIT_ALIAS}", "", "",
+    lines = [f"import math as {MATH_ALIAS}",
+             f"from numba import carray as {CARRAY_ALIAS}, cfunc as {CFUNC_ALIAS}, "
+             f"njit as {NJIT_ALIAS}", "", "",
              DECORATOR,
              f"def condition_function(r, t, x, y, q, {CONSTANTS_NAME}):"]
     for r, text in sorted(expressions.items()):
         src = parametrized_expression(text, constants)
         lines.append(f"    if r == {int(r)}:")
         lines.append(f"        return {src}")
-    lines.append("    return 0.0")
+    lines += ["    return 0.0", "", "",
+              f"@{CFUNC_ALIAS}('{CFUNC_SIGNATURE}', cache=True, error_model='numpy')",
+              "def condition_cfunc(r, t, x, y, q, c, n):",
+              f"    return condition_function(r, t, x, y, q, {CARRAY_ALIAS}(c, n))"]
     return "\n".join(lines) + "\n", np.array(constants, dtype=np.float64)

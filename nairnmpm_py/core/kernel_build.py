@@ -9,8 +9,8 @@ a dispatcher over exactly the scene's updates, and append the driver.  A scene w
 cracks also gets a copy of the crack tasks' template (``tasks.CRACKS``) with its
 traction-law envelopes, imported by the step copy.  A copy is written once per
 distinct source; later runs load it and its Numba cache, which makes warm starts
-fast.  Numbers in the condition expressions are runtime constants, so scenes that
-differ only in them share one copy.
+fast.  The condition expressions are a small module of their own, which the kernels
+call through its address (``expressions``), so they never change the step's copy.
 """
 from __future__ import annotations
 
@@ -28,7 +28,6 @@ from .tasks import CRACKS, driver_source, step_tasks
 
 MARKER = "# KERNEL-MATERIALS"
 SHAPE_MARKER = "# KERNEL-SHAPE"
-FUNCTIONS_MARKER = "# KERNEL-FUNCTIONS"
 FIELDS_MARKER = "# KERNEL-FIELDS"
 MULTI_FIELD_MARKER = "# KERNEL-MULTI-FIELD"
 UPDATE_STRESS_MARKER = "# KERNEL-UPDATE-STRESS"
@@ -90,13 +89,21 @@ def _replace_marked(lines: list[str], marker: str, text: str, where: str) -> Non
     lines[hits[0]] = text
 
 
+def condition_functions(expressions: dict[int, str]) -> tuple[int, np.ndarray]:
+    """(address of ``condition_cfunc``, its constants) for a scene's style-6 condition
+    expressions (record index -> expression of t); (0, empty) without any."""
+    if not expressions:
+        return 0, np.zeros(0)
+    source, constants = condition_module_source(expressions)
+    module = _load_source(source, "nairnmpm_conditions", [])
+    return int(module.condition_cfunc.address), constants
+
+
 def load_kernels(update_functions: list[str], shape: int = 1,
-                 expressions: dict[int, str] | None = None,
                  crack_envelopes: list[str] | None = None, update_stress: bool = True):
-    """(kernel module, condition constants) for a scene whose materials use these
-    update functions (in order), with one kind of shape function (0 linear, 1 uGIMP),
-    the scene's style-6 condition expressions (record index -> expression of t) and,
-    for a scene with cracks, the traction envelopes of its laws ("module:function",
+    """The kernel module for a scene whose materials use these update functions (in
+    order), with one kind of shape function (0 linear, 1 uGIMP) and, for a scene
+    with cracks, the traction envelopes of its laws ("module:function",
     index = kind in the law tables).  The module's ``advance`` is the step driver.
     ``update_stress`` False (USF, USL+, USAVG+: the particle update never updates
     stresses) leaves the material updates out of the particle update's code.
@@ -111,12 +118,9 @@ def load_kernels(update_functions: list[str], shape: int = 1,
     if not update_stress:
         _replace_marked(lines, UPDATE_STRESS_MARKER, "UPDATE_STRESS = False  # USF / USL+ / USAVG+",
                         where)
-    constants = np.zeros(0)
-    if expressions:
-        source, constants = condition_module_source(expressions)
-        _replace_marked(lines, FUNCTIONS_MARKER, source, where)
     refs = update_functions + ["nairnmpm_py.core.shape:x", "nairnmpm_py.core.grid_ops:x",
-                               "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x"]
+                               "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x",
+                               "nairnmpm_py.core.expressions:x"]
     with_cracks = crack_envelopes is not None
     if with_cracks:
         cracks = _load_crack_tasks(shape, crack_envelopes)
@@ -128,7 +132,7 @@ def load_kernels(update_functions: list[str], shape: int = 1,
         _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
         refs.append(cracks.__name__ + ":x")
     source = "\n".join(lines) + "\n\n" + driver_source(with_cracks)
-    return _load_source(source, "nairnmpm_kernels", refs), constants
+    return _load_source(source, "nairnmpm_kernels", refs)
 
 
 def _dependency_text(refs: list[str]) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import SimulationUnstable
 from .conditions import GRID_VELOCITY, ConditionRecord, Conditions
 from .grid import Grid
-from .kernel_build import load_kernels, material_table
+from .kernel_build import condition_functions, load_kernels, material_table
 from .particles import Particles
 from .profile import StepProfile
 from .tasks import periodic_task
@@ -130,8 +130,9 @@ class Simulation:
         envelopes = self.cracks.envelope_functions() if self.cracks is not None else None
         # the particle update updates stresses only in USL- and USAVG-
         self._update_stress = stress_split(self.method, self.post_extrapolate, 1.0)[2] > 0.0
-        self.kernels, self.fconst = load_kernels(functions, self.shape, expressions, envelopes,
-                                                 self._update_stress)
+        self.kernels = load_kernels(functions, self.shape, envelopes, self._update_stress)
+        address, self.fconst = condition_functions(expressions)
+        self.faddr = np.array([address], dtype=np.int64)
         self.nch = threads if self.parallel else 1
         nn = g.n_nodes
         nf, rows = (self.cracks.nf, self.cracks.n_rows) if self.cracks else (1, N_ROWS)
@@ -223,7 +224,8 @@ class Simulation:
                             c["pbc_dir"], c["pbc_scale"], c["pbc_face"], c["pbc_rec"],
                             c["rec_style"], c["rec_value"], c["rec_t0"], c["rec_ftime"],
                             self.rec_force, self.rec_work, self.sym_out, self.sym_in,
-                            self.sym_dir, self.pload, self.pos_before, self.fconst)
+                            self.sym_dir, self.pload, self.pos_before, self.fconst,
+                            self.faddr)
         K = self.cracks.bundle(self) if self.cracks is not None else NO_CRACKS
         first, last, update, plus = stress_split(self.method, self.post_extrapolate, self.dt)
         if update > 0.0 and not self._update_stress:

@@ -56,7 +56,7 @@ ConditionArrays = namedtuple("ConditionArrays", [
     "rec_force", "rec_work",                                       # results per record
     "sym_out", "sym_in", "sym_dir",                                # symmetry-plane mirrors
     "pload", "pos_before",                                         # load work scratch
-    "fconst",                                                      # style-6 constants
+    "fconst", "faddr",          # style-6 constants; (1,) address of their condition_cfunc
 ])
 
 Settings = namedtuple("Settings", [

@@ -45,7 +45,7 @@ from nairnmpm_py.core.shape import weights_1d
 from nairnmpm_py.core.state import (GM, GPX, GPY, GFX, GFY, CLOCK_T, CLOCK_PENDING, STATUS_OK,
                                     STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY)
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
-from nairnmpm_py.core.expressions import no_condition_function as condition_function  # KERNEL-FUNCTIONS
+from nairnmpm_py.core.expressions import call_condition
 from nairnmpm_py.core.single_field import assign_and_scatter, field_lists  # KERNEL-FIELDS
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
@@ -86,7 +86,9 @@ def bc_value(C, r, t, x, y, q):
     if style == 4:
         return value * math.cos(C.rec_ftime[r] * t)
     if style == 6:
-        return value * condition_function(r, t - t0, x, y, q, C.fconst) if t >= t0 else 0.0
+        if t < t0:
+            return 0.0
+        return value * call_condition(C.faddr[0], r, t - t0, x, y, q, C.fconst)
     return 0.0
 
 
@@ -540,7 +542,7 @@ def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
             _internal_forces(buf, p, r, i0, j0, nnx, vfld, cut, sxx, syy, sxy)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def stress_and_forces(P, G, C, K, S):
     """Stress update (USF / USAVG first half, plus a carried-over USAVG+ / USL+ last
     half) fused with the internal forces into the chunk buffers."""
@@ -549,7 +551,7 @@ def stress_and_forces(P, G, C, K, S):
     _stress_pass(P, G, K, S, pending, S.dt_first, S.nch > 0)   # a runtime True (see flush)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def flush_stress(P, G, C, K, S):
     """Apply a carried USAVG+ / USL+ stress half now (before stresses or energies are
     read, or when a run stops)."""
@@ -768,14 +770,14 @@ def _particle_pass(P, G, K, S, move):
             chunk_counts[c] = conflicts
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def weights_and_mass(P, G, C, K, S):
     """Weights of every particle (cached) and their mass and momentum on the grid."""
     _particle_pass(P, G, K, S, S.nch < 0)   # a runtime False (see flush_stress)
 
 
 # ---- grid -> particles -----------------------------------------------------------------
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, inline="always")
 def update_and_extrapolate(P, G, C, K, S):
     """Grid -> particles, then each particle's new weights and its mass and momentum
     back to the grid (the next extrapolation: in every method positions and

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from ..plugins import registry
 from .bundle import NR, CrackArrays
 from .geometry import EXTERIOR_END, CrackSet
 from .jintegral import (N_PER_MM_TO_J_PER_M2, NodalFields, StepAssignment, j_integral,
@@ -32,6 +33,7 @@ from .jintegral import (N_PER_MM_TO_J_PER_M2, NodalFields, StepAssignment, j_int
 INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
 NO_MODE = -1.0
 WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J window
+BUILTIN = "nairnmpm_py."   # envelope functions of the package's own traction laws
 
 
 @njit(cache=True)
@@ -106,8 +108,14 @@ class CrackScene:
         return 2 if self.cracks.n_cracks == 1 else 4
 
     def envelope_functions(self) -> list[str]:
-        """The traction envelopes the crack tasks dispatch over (law table kind = index)."""
-        return sorted({self.laws[m].envelope_function for m in self.laws})
+        """The traction envelopes the crack tasks dispatch over (law table kind = index):
+        every built-in law's, then the scene's outside laws'.  Scenes that differ only
+        in their laws then share one compiled crack kernel (a crack variant costs a
+        minute or more to compile; the envelopes add a few seconds to it)."""
+        own = {self.laws[m].envelope_function for m in self.laws}
+        builtin = {info.cls.envelope_function for info in registry("traction_laws")
+                   if getattr(info.cls, "envelope_function", "").startswith(BUILTIN)}
+        return sorted(builtin) + sorted(own - builtin)
 
     def prepare(self, sim) -> None:
         functions = self.envelope_functions()
