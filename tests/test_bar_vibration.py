@@ -141,7 +141,6 @@ def test_tip_amplitude_is_v0_over_omega(studies, shape):
     assert r["amplitude"] == pytest.approx(expected, rel=0.01)
 
 
-
 METHODS = {  # MPMMethod and whether NairnMPM's post-update extrapolation is skipped
     "USF": ("<MPMMethod>0</MPMMethod>", False),
     "USAVG+": ("<MPMMethod>2</MPMMethod>", False),
