@@ -244,9 +244,11 @@ class Simulation:
         changed from outside between calls need ``grid_current = False`` first."""
         self.prepare()
         p = self.particles
-        threads = numba.get_num_threads()
-        if not self.parallel:
-            numba.set_num_threads(1)  # one chunk: no thread pool, no barriers
+        # one chunk: no thread pool, no barriers (asked only then: the two calls cost
+        # about 10 us, a propagation check calls the driver every step)
+        threads = numba.get_num_threads() if not self.parallel else 0
+        if threads:
+            numba.set_num_threads(1)
         try:
             self.clock[0] = self.time
             if self.profiler is None:
@@ -255,7 +257,8 @@ class Simulation:
                 done = self.kernels.advance_profiled(*self.bundles(), nsteps, self.grid_current,
                                                      flush, self.profiler.cycles)
         finally:
-            numba.set_num_threads(threads)
+            if threads:
+                numba.set_num_threads(threads)
         status, bad = int(self.status[0]), int(self.status[1])
         self.grid_current = status == 0
         self.step += int(done)
