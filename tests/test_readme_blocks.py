@@ -13,6 +13,8 @@ Every fenced block of README.md is extracted and checked by its language:
   with the reason it is not run, so a new kind of command fails here until it is
   classified.
 * ``toml``: must parse, and its entry-point groups must be the package's plugin groups.
+* ``text``: a ``--profile`` table as the command prints it; every row must name a task
+  of the step list, a periodic task or one of the table's own rows.
 
 Tests are parametrized by block, named after the README line of the opening fence.
 """
@@ -51,7 +53,7 @@ EXCLUDED_COMMANDS = {
 # its tables, which are prose, not fenced blocks.
 
 SHELL_LANGS = {"sh", "bash", "console", "shell"}
-HANDLED_LANGS = {"python", "xml", "toml"} | SHELL_LANGS
+HANDLED_LANGS = {"python", "xml", "toml", "text"} | SHELL_LANGS
 TINY_UPDATES = 2e6       # particles x steps below which an XML input block is also run
 
 
@@ -255,3 +257,21 @@ def test_toml_block_names_plugin_groups(block):
         assert group in GROUPS.values(), f"README.md:{block.line}: unknown plugin group {group}"
         for name, target in entries.items():
             assert re.fullmatch(r"[\w.]+:\w+", target), f"README.md:{block.line}: {name} = {target}"
+
+
+# --------------------------------------------------------------------------- text
+
+@pytest.mark.parametrize("block", _of("text"))
+def test_text_block_is_a_profile_table_of_real_tasks(block):
+    from nairnmpm_py.core.profile import BETWEEN_CALLS
+    from nairnmpm_py.core.tasks import PERIODIC, profile_rows
+    known = set(profile_rows(True)) | {p.name for p in PERIODIC} | {BETWEEN_CALLS, "whole step"}
+    lines = block.text.strip().splitlines()
+    assert lines[0].split() == ["task", "ms/step", "share"] and set(lines[1]) == {"-"}
+    names = []
+    for line in lines[2:]:
+        m = re.match(r"(.+?)\s+(\d+\.\d+)\s+(\d+\.\d) %$", line)
+        assert m, f"README.md:{block.line}: not a profile row: {line!r}"
+        names.append(m.group(1))
+    assert not set(names) - known, f"README.md:{block.line}: unknown rows {set(names) - known}"
+    assert names[-1] == "whole step"
