@@ -54,6 +54,28 @@ def wave_speed(E=E_MPA, nu=NU, rho=RHO) -> float:
     return math.sqrt((lam + 2 * g) / (rho * 1e-3))
 
 
+def _one_body(grid: str, rect: str, name: str) -> str:
+    """The mesh (1 mm cells), the one rectangular body and its material: the part of
+    both scenes that differs only in sizes (``{rho:g}`` and ``{nu:g}`` stay fields)."""
+    return f"""  <Mesh>
+    <Grid {grid}>
+      <Horiz cellsize="1"/>
+      <Vert cellsize="1"/>
+    </Grid>
+  </Mesh>
+  <MaterialPoints>
+    <Body mat="1" thick="1">
+      <Rect {rect}/>
+    </Body>
+  </MaterialPoints>
+  <Material Type="1" Name="{name}">
+    <rho>{{rho:g}}</rho>
+    <E>&E;</E>
+    <nu>{{nu:g}}</nu>
+  </Material>
+"""
+
+
 BEAM_XML = """<?xml version="1.0"?>
 <!DOCTYPE JANFEAInput [
   <!ENTITY E "{E:g}">
@@ -77,23 +99,8 @@ BEAM_XML = """<?xml version="1.0"?>
     <ArchiveTime units="ms">0.1</ArchiveTime>
     <TimeFactor>0.5</TimeFactor>
   </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="108" ymin="-12" ymax="24">
-      <Horiz cellsize="1"/>
-      <Vert cellsize="1"/>
-    </Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="1">
-      <Rect xmin="0" xmax="100" ymin="0" ymax="12"/>
-    </Body>
-  </MaterialPoints>
-  <Material Type="1" Name="beam">
-    <rho>{rho:g}</rho>
-    <E>&E;</E>
-    <nu>{nu:g}</nu>
-  </Material>
-  <GridBCs>
+""" + _one_body('xmin="-4" xmax="108" ymin="-12" ymax="24"',
+                   'xmin="0" xmax="100" ymin="0" ymax="12"', "beam") + """  <GridBCs>
     <BCLine x1="0" y1="min" x2="0" y2="max">
       <DisBC dir="1" vel="0"/>
       <DisBC dir="2" vel="0"/>
@@ -132,23 +139,8 @@ BLOCK_XML = """<?xml version="1.0"?>
     <TimeStep units="ms">2.5e-4</TimeStep>
     <ArchiveTime units="ms">0.05</ArchiveTime>
   </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="160" ymin="-4" ymax="60">
-      <Horiz cellsize="1"/>
-      <Vert cellsize="1"/>
-    </Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="1">
-      <Rect xmin="0" xmax="150" ymin="0" ymax="50"/>
-    </Body>
-  </MaterialPoints>
-  <Material Type="1" Name="block">
-    <rho>{rho:g}</rho>
-    <E>&E;</E>
-    <nu>{nu:g}</nu>
-  </Material>
-  <GridBCs>
+""" + _one_body('xmin="-4" xmax="160" ymin="-4" ymax="60"',
+                   'xmin="0" xmax="150" ymin="0" ymax="50"', "block") + """  <GridBCs>
     <BCLine x1="min" y1="0" x2="max" y2="0">
       <DisBC dir="2" vel="0"/>
     </BCLine>

@@ -1,6 +1,7 @@
 """Helpers for the simulation tests: build a scene from XML text, record a run."""
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,21 @@ class Recorder:
 
     def column(self, name: str) -> np.ndarray:
         return np.array([r[name] for r in self.rows], dtype=float)
+
+
+def scene_xml(header: str, grid: str, bodies: str, rest: str = "", analysis="11") -> str:
+    """An input file with the tests' usual skeleton: ``header`` inside <MPMHeader>,
+    ``grid`` inside <Mesh>, ``bodies`` inside <MaterialPoints>, then ``rest``
+    (cracks, materials, conditions).  The parts are pasted as given, so they may
+    carry ``str.format`` fields for the caller to fill."""
+    def part(text: str, indent: int) -> str:
+        return textwrap.indent(textwrap.dedent(text).strip("\n"), " " * indent)
+    return (f'<?xml version="1.0"?>\n<JANFEAInput version="3">\n'
+            f"  <Header><Analysis>{analysis}</Analysis></Header>\n"
+            f"  <MPMHeader>\n{part(header, 4)}\n  </MPMHeader>\n"
+            f"  <Mesh>\n{part(grid, 4)}\n  </Mesh>\n"
+            f"  <MaterialPoints>\n{part(bodies, 4)}\n  </MaterialPoints>\n"
+            f"{part(rest, 2)}\n</JANFEAInput>\n")
 
 
 def write(tmp_path: Path, text: str, name: str = "scene.xml") -> Path:

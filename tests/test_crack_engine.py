@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mpm_helpers import Recorder, build
+from mpm_helpers import Recorder, build, scene_xml
 
 AREA = 4.0          # mm^2, 4 mm x 1 mm
 SIGMA_C = 1.0       # MPa
@@ -48,24 +48,16 @@ def bar_xml(v: float, t_end: float, t_reverse: float = 99.0, law: bool = True,
     cracks = f"<CrackList>\n      {crack_points(20.5, law)}\n    </CrackList>"
     if second_crack:
         cracks += f"\n    <CrackList>\n      {crack_points(30.5, False)}\n    </CrackList>"
-    return f"""<?xml version="1.0"?>
-<JANFEAInput version="3">
-  <Header><Analysis>11</Analysis></Header>
-  <MPMHeader>
-    <GIMP/>
+    return scene_xml(
+        header=f"""<GIMP/>
     <MaxTime units="ms">{t_end}</MaxTime>
     <GlobalArchiveTime units="ms">0.02</GlobalArchiveTime>
-    <Damping>5000</Damping>
-  </MPMHeader>
-  <Mesh>
-    <Grid xmin="-2" xmax="42" ymin="-2" ymax="6" thickness="1">
+    <Damping>5000</Damping>""",
+        grid="""<Grid xmin="-2" xmax="42" ymin="-2" ymax="6" thickness="1">
       <Horiz cellsize="1"/><Vert cellsize="1"/>
-    </Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body matname="bar" thick="1"><Rect xmin="0" xmax="40" ymin="0" ymax="4"/></Body>
-  </MaterialPoints>
-  {cracks}
+    </Grid>""",
+        bodies='<Body matname="bar" thick="1"><Rect xmin="0" xmax="40" ymin="0" ymax="4"/></Body>',
+        rest=f"""{cracks}
   <Material Type="1" Name="bar"><rho>1</rho><E>1000</E><nu>0.3</nu></Material>
   <Material Type="12" Name="glue">
     <sigmaI>{SIGMA_C}</sigmaI><delIc>{DELTA_C}</delIc><sigmaII>1</sigmaII><delIIc>0.1</delIIc>
@@ -76,9 +68,7 @@ def bar_xml(v: float, t_end: float, t_reverse: float = 99.0, law: bool = True,
       <DisBC dir="1" vel="{v}"/>
       <DisBC dir="1" vel="{-2 * v}" time="{t_reverse}"/>
     </BCLine>
-  </GridBCs>
-</JANFEAInput>
-"""
+  </GridBCs>""")
 
 
 def run_bar(tmp_path, **kw):

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mpm_helpers import Recorder, build, line_of
+from mpm_helpers import Recorder, build, line_of, scene_xml
 
 L, W, THICK = 100.0, 10.0, 1.0      # mm
 E, NU = 1000.0, 0.3                 # MPa
@@ -25,24 +25,17 @@ T_RAMP, T_END = 1.0, 2.0            # ms
 AREA = W * THICK
 SIGMA = F / AREA                    # 1 MPa
 
-XML = """<?xml version="1.0"?>
-<JANFEAInput version="3">
-  <Header><Analysis>{analysis}</Analysis></Header>
-  <MPMHeader>
-    <GIMP/>
+XML = scene_xml(
+    analysis="{analysis}",
+    header="""<GIMP/>
     <MaxTime units="ms">{t_end}</MaxTime>
     <GlobalArchiveTime units="ms">0.05</GlobalArchiveTime>
-    <Damping>15708</Damping>
-  </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="{gx}" ymin="-4" ymax="{gy}" thickness="{thick}">
+    <Damping>15708</Damping>""",
+    grid="""<Grid xmin="-4" xmax="{gx}" ymin="-4" ymax="{gy}" thickness="{thick}">
       <Horiz cellsize="2"/><Vert cellsize="2"/>
-    </Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="{thick}"><Rect xmin="0" xmax="{L}" ymin="0" ymax="{W}"/></Body>
-  </MaterialPoints>
-  <Material Type="1" Name="bar"><rho>1</rho><E>{E}</E><nu>{nu}</nu></Material>
+    </Grid>""",
+    bodies='<Body mat="1" thick="{thick}"><Rect xmin="0" xmax="{L}" ymin="0" ymax="{W}"/></Body>',
+    rest="""<Material Type="1" Name="bar"><rho>1</rho><E>{E}</E><nu>{nu}</nu></Material>
   <GridBCs>
     <BCLine x1="0" y1="min" x2="0" y2="max"><DisBC dir="1" vel="0"/></BCLine>
   </GridBCs>
@@ -52,9 +45,7 @@ XML = """<?xml version="1.0"?>
       <LoadBC dir="1" style="2" load="{rate}" time="0"/>
       <LoadBC dir="1" style="2" load="-{rate}" time="{t_ramp}"/>
     </LdRect>
-  </ParticleBCs>
-</JANFEAInput>
-"""
+  </ParticleBCs>""")
 
 
 def run(tmp_path, analysis: int) -> dict:

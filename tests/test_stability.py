@@ -11,28 +11,18 @@ import pytest
 from nairnmpm_py.analysis.results import open_results
 from nairnmpm_py.cli import main
 
-from mpm_helpers import write
+from mpm_helpers import scene_xml, write
 
-BAR = """<?xml version="1.0"?>
-<JANFEAInput version="3">
-  <Header><Analysis>11</Analysis></Header>
-  <MPMHeader>
-    {timing}
+BAR = scene_xml(
+    header="""{timing}
     <GlobalArchiveTime units="ms">0.004</GlobalArchiveTime>
-    <ArchiveTime units="ms">0.02</ArchiveTime>
-  </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="108" ymin="-4" ymax="6"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="1" vx="1000"><Rect xmin="0" xmax="100" ymin="0" ymax="2"/></Body>
-  </MaterialPoints>
-  <Material Type="1" Name="bar"><rho>1</rho><E>1000</E><nu>0</nu></Material>
+    <ArchiveTime units="ms">0.02</ArchiveTime>""",
+    grid='<Grid xmin="-4" xmax="108" ymin="-4" ymax="6"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>',
+    bodies='<Body mat="1" thick="1" vx="1000"><Rect xmin="0" xmax="100" ymin="0" ymax="2"/></Body>',
+    rest="""<Material Type="1" Name="bar"><rho>1</rho><E>1000</E><nu>0</nu></Material>
   <GridBCs>
     <BCLine x1="0" y1="min" x2="0" y2="max"><DisBC dir="1" vel="0"/></BCLine>
-  </GridBCs>
-</JANFEAInput>
-"""
+  </GridBCs>""")
 
 TIMINGS = {
     "Timing-CFL-3": '<Timing CFL="3" max="2" units="ms"/>',

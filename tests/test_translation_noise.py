@@ -21,27 +21,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mpm_helpers import Recorder, build
+from mpm_helpers import Recorder, build, scene_xml
 
 SHAPES = {"linear": "", "uGIMP": "<GIMP/>"}
 
-BLOCK = """<?xml version="1.0"?>
-<JANFEAInput version="3">
-  <Header><Analysis>11</Analysis></Header>
-  <MPMHeader>
-    {shape}
+BLOCK = scene_xml(
+    header="""{shape}
     <MaxTime units="ms">2</MaxTime>
-    <GlobalArchiveTime units="ms">0.02</GlobalArchiveTime>
-  </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="60" ymin="-4" ymax="14"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="1" vx="{vx}" vy="{vy}"><Rect xmin="0" xmax="20" ymin="0" ymax="10"/></Body>
-  </MaterialPoints>
-  <Material Type="1" Name="block"><rho>1</rho><E>1000</E><nu>0.3</nu></Material>
-</JANFEAInput>
-"""
+    <GlobalArchiveTime units="ms">0.02</GlobalArchiveTime>""",
+    grid='<Grid xmin="-4" xmax="60" ymin="-4" ymax="14"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>',
+    bodies='<Body mat="1" thick="1" vx="{vx}" vy="{vy}"><Rect xmin="0" xmax="20" ymin="0" ymax="10"/></Body>',
+    rest='<Material Type="1" Name="block"><rho>1</rho><E>1000</E><nu>0.3</nu></Material>')
 
 
 @pytest.mark.parametrize("shape", list(SHAPES))
@@ -68,23 +58,13 @@ def test_stress_free_translation_is_exact(tmp_path, shape):
 
 
 BAR_L = 40.0
-BAR = """<?xml version="1.0"?>
-<JANFEAInput version="3">
-  <Header><Analysis>11</Analysis></Header>
-  <MPMHeader>
-    {shape}
+BAR = scene_xml(
+    header="""{shape}
     <MaxTime units="ms">2</MaxTime>
-    <GlobalArchiveTime units="ms">0.005</GlobalArchiveTime>
-  </MPMHeader>
-  <Mesh>
-    <Grid xmin="-4" xmax="80" ymin="-4" ymax="8"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>
-  </Mesh>
-  <MaterialPoints>
-    <Body mat="1" thick="1"><Rect xmin="0" xmax="40" ymin="0" ymax="4"/></Body>
-  </MaterialPoints>
-  <Material Type="1" Name="bar"><rho>1</rho><E>1000</E><nu>0</nu></Material>
-</JANFEAInput>
-"""
+    <GlobalArchiveTime units="ms">0.005</GlobalArchiveTime>""",
+    grid='<Grid xmin="-4" xmax="80" ymin="-4" ymax="8"><Horiz cellsize="2"/><Vert cellsize="2"/></Grid>',
+    bodies='<Body mat="1" thick="1"><Rect xmin="0" xmax="40" ymin="0" ymax="4"/></Body>',
+    rest='<Material Type="1" Name="bar"><rho>1</rho><E>1000</E><nu>0</nu></Material>')
 
 
 def vibrating_bar_noise(folder, shape: str, speed: float) -> dict:
