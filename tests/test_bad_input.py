@@ -79,6 +79,18 @@ CASES = {
                                     '<Line xmin="-1"', r"crack tip material: material 2 \('glue'\) is not a solid material"),
     "crack-law-name-unknown": ("</MaterialPoints>", '</MaterialPoints>\n  <CrackList>\n    <Line xmin="-1" ymin="2.1" xmax="10" ymax="2.1" resolution="4" matname="glue"/>\n  </CrackList>',
                                '<Line xmin="-1"', r"crack mat: no material named 'glue'"),
+    # NairnMPM refuses a file without an analysis type with this message
+    "no-header": ("  <Header><Analysis>11</Analysis></Header>\n", "", "<JANFEAInput",
+                  r"No FEA or MPM analysis type was provided"),
+    "max-time-negative": ('<MaxTime units="ms">0.05</MaxTime>', '<MaxTime units="ms">-5</MaxTime>',
+                          '<MaxTime units="ms">-5', r"<MaxTime> must be > 0 \(got -5\)"),
+    "max-time-zero-timing": ('<MaxTime units="ms">0.05</MaxTime>', '<Timing max="0" units="ms"/>',
+                             '<Timing max="0"', r"<Timing max=...> must be > 0"),
+    # refused from an estimate before anything is allocated (the grid alone would need
+    # petabytes)
+    "absurd-resolution": ('<Horiz cellsize="2"/><Vert cellsize="2"/>',
+                          '<Horiz cellsize="1e-6"/><Vert cellsize="1e-6"/>', "<Grid xmin",
+                          r"particles: about .* GiB, more than this machine's .* GiB of memory"),
 }
 
 PROBLEM_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<msg>.+)$")

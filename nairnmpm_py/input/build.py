@@ -6,6 +6,7 @@ velocities mm/s -> mm/ms, densities g/cm^3 -> g/mm^3, damping 1/s -> 1/ms.
 from __future__ import annotations
 
 import math
+import os
 import re
 
 import numpy as np
@@ -32,6 +33,8 @@ def load_simulation(path) -> Simulation:
 def build_simulation(model: InputModel) -> Simulation:
     r = Reader(model.path)
     grid = _grid(r, model)
+    r.check()
+    _check_size(r, model, grid)
     r.check()
     _check_cracks(r, model, grid)
     r.check()
@@ -97,6 +100,46 @@ def _grid(r: Reader, model: InputModel) -> Grid:
 class _at:
     def __init__(self, line):
         self.sourceline = line
+
+
+# Rough memory per particle and per grid node, in bytes: the particle arrays and their
+# copies (outputs, J), the grid rows of up to four velocity fields per node with one
+# buffer per thread, and the candidate points particles are cut from (every cell of
+# the grid, points_per_cell of them).  Measured runs stay well under these.
+BYTES_PER_PARTICLE = 1000
+BYTES_PER_NODE = 1000
+BYTES_PER_CANDIDATE = 24
+
+
+def _machine_memory() -> int | None:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _check_size(r: Reader, model: InputModel, grid: Grid) -> None:
+    """Refuse, before anything is allocated, a resolution this machine cannot hold."""
+    have = _machine_memory()
+    if have is None:
+        return
+    ppc = max([b.points_per_cell or model.mpm.points_per_cell for b in model.bodies]
+              + [model.mpm.points_per_cell])
+    cell_area = grid.dx * grid.dy
+    particles = 0.0
+    for body in model.bodies:
+        if not body.hole:
+            for shape in body.shapes:
+                x0, x1, y0, y1 = _bbox(shape)
+                particles += (x1 - x0) * (y1 - y0) / cell_area * ppc
+    particles = min(particles, grid.n_cells * ppc)
+    need = (particles * BYTES_PER_PARTICLE + grid.n_nodes * BYTES_PER_NODE
+            + grid.n_cells * ppc * BYTES_PER_CANDIDATE)
+    if need > have:
+        r.problem(_at(model.grid.line),
+                  f"the grid has {grid.n_cells:.3g} cells ({grid.dx:g} x {grid.dy:g} mm) and "
+                  f"the bodies about {particles:.3g} particles: about {need / 2**30:.3g} GiB, "
+                  f"more than this machine's {have / 2**30:.3g} GiB of memory; use larger cells")
 
 
 # ---- cracks -------------------------------------------------------------------------

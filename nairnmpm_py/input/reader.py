@@ -32,8 +32,8 @@ def read_input(path: str | Path) -> InputModel:
         r.problem(root, f"root element is <{root.tag}>, expected <JANFEAInput>")
         r.check()
     r.attrs(root, {"version": int})
-    parts = {"title": "", "analysis": 10, "mpm": None, "grid": None, "bodies": [],
-             "materials": [], "conditions": [], "cracks": []}
+    parts = {"title": "", "analysis": 10, "analysis_given": False, "mpm": None, "grid": None,
+             "bodies": [], "materials": [], "conditions": [], "cracks": []}
     mesh_seen = False
     material_elements = 0
     for el in r.children(root):
@@ -73,6 +73,10 @@ def read_input(path: str | Path) -> InputModel:
                 parts["cracks"].append(crack)
         else:
             r.unknown(el, "JANFEAInput")
+    if not parts.pop("analysis_given"):
+        # NairnMPM refuses such a file too, with this message
+        r.problem(root, "No FEA or MPM analysis type was provided: add <Header><Analysis>10"
+                        "</Analysis></Header> (10 plane strain, 11 plane stress)")
     if parts["mpm"] is None:
         r.problem(root, "missing <MPMHeader>")
     if not mesh_seen or parts["grid"] is None:
@@ -92,6 +96,7 @@ def _header(r: Reader, el, parts) -> None:
         if c.tag == "Description":
             parts["title"] = (c.text or "").strip()
         elif c.tag == "Analysis":
+            parts["analysis_given"] = True
             v = r.text(c, int)
             if v is not None and v not in (10, 11):
                 r.problem(c, f"<Analysis>{v}</Analysis>: only 10 (plane strain MPM) and 11 "
@@ -112,6 +117,17 @@ def _time(r: Reader, el, value: float | None, units: str | None) -> float | None
                       "(use s, ms, msec, us or microsec)")
         return None
     return value * TIME_UNITS_TO_MS[key]
+
+
+def _positive_time(r: Reader, el, value: float | None, units: str | None,
+                   attribute: str) -> float | None:
+    """A time that must be > 0 (the run's end); None, with a problem, when it is not."""
+    ms = _time(r, el, value, units)
+    if ms is not None and not ms > 0.0:
+        what = f"<{el.tag} {attribute}=...>" if attribute else f"<{el.tag}>"
+        r.problem(el, f"{what} must be > 0 (got {value:g})")
+        return None
+    return ms
 
 
 def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
@@ -137,8 +153,9 @@ def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
                 h["shape"] = kind
         elif tag == "Timing":
             a = r.attrs(c, {"step": float, "max": float, "CFL": float, "units": str})
-            if "max" in a:
-                h["max_time_ms"] = _time(r, c, a["max"], a.get("units"))
+            end = _positive_time(r, c, a.get("max"), a.get("units"), "max")
+            if end is not None:
+                h["max_time_ms"] = end
             if "step" in a:
                 h["time_step_ms"] = _time(r, c, a["step"], a.get("units"))
             if "CFL" in a:
@@ -146,7 +163,10 @@ def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
         elif tag in ("MaxTime", "TimeStep", "ArchiveTime", "GlobalArchiveTime",
                      "FirstArchiveTime"):
             a = r.attrs(c, {"units": str, "maxProps": int})
-            v = _time(r, c, r.text(c, float), a.get("units"))
+            if tag == "MaxTime":
+                v = _positive_time(r, c, r.text(c, float), a.get("units"), "")
+            else:
+                v = _time(r, c, r.text(c, float), a.get("units"))
             key = {"MaxTime": "max_time_ms", "TimeStep": "time_step_ms",
                    "ArchiveTime": "archive_time_ms", "GlobalArchiveTime": "global_archive_time_ms",
                    "FirstArchiveTime": "archive_start_ms"}[tag]
