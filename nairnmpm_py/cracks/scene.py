@@ -34,6 +34,9 @@ INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cst
 NO_MODE = -1.0
 WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J window
 BUILTIN = "nairnmpm_py."   # envelope functions of the package's own traction laws
+# the cracks.csv columns a lean propagation check computes (``_tip_row(lean=True)``)
+J_COLUMNS = {"J_contour_J_m2", "J_tip_J_m2", "J_ff_J_m2", "W_B_crossing_J_m2",
+             "W_B_root_J_m2", "W_B_rec_root_J_m2"}
 
 
 @njit(cache=True)
@@ -317,10 +320,11 @@ class CrackScene:
         extrapolated again first, as the next step would do anyway."""
         if not sim.grid_current:
             sim.advance(0, flush=False)
-        P, G, _, K, _ = sim.bundles()
-        step = StepAssignment(K.vfld, K.cut, K.nslot, G.g, P.wij, P.wc)
-        return step_nodal_fields(sim.grid, P, step, sim.shape, strict=False, window=window,
-                                 subset=self._window_particles(sim, window))
+        # the arrays the step's bundles carry, read directly (building the five
+        # bundles costs more than this whole call's Python)
+        step = StepAssignment(self.vfld, self.cut, self.nslot, sim.g, sim.wij, sim.wc)
+        return step_nodal_fields(sim.grid, sim.particles, step, sim.shape, strict=False,
+                                 window=window, subset=self._window_particles(sim, window))
 
     def _contour_window(self, sim, tips, size: int) -> tuple[int, int, int, int]:
         """Real-grid node columns and rows (inclusive) holding the contours of
@@ -349,7 +353,9 @@ class CrackScene:
             self._subset_age = 0
         return self._subset
 
-    def _tip_row(self, sim, fields, tip: Tip, size: int) -> dict:
+    def _tip_row(self, sim, fields, tip: Tip, size: int, lean: bool = False) -> dict:
+        """The tip's cracks.csv row; ``lean`` leaves out what no J column needs (K and
+        the COD at the original notch root stay NaN)."""
         cs = self.cracks
         key = (tip.crack, tip.end)
         xt = self._tip_point(tip)
@@ -367,7 +373,8 @@ class CrackScene:
                "W_B_crossing_J_m2": math.nan,
                "W_B_root_J_m2": w_root, "W_B_rec_root_J_m2": w_rec, "R_J_m2": math.nan,
                "cod_root_mm": cod_root,
-               "cod_notch0_mm": self.root_edge(tip, self._index_of(self.initial_root[key]))[1],
+               "cod_notch0_mm": math.nan if lean else
+               self.root_edge(tip, self._index_of(self.initial_root[key]))[1],
                "KI_MPa_sqrt_m": math.nan, "KII_MPa_sqrt_m": math.nan, "event": "archive",
                "error": ""}
         try:
@@ -396,7 +403,7 @@ class CrackScene:
             # Eq 15: the energy released per unit growth
             jc = tip.criterion.critical_J(sim.materials[tip.material])
             row["R_J_m2"] = jc + w_root - w_rec
-        if tip.material >= 0:
+        if tip.material >= 0 and not lean:
             consts = sim.materials[tip.material].shear_and_poisson()
             if consts is not None:
                 dn, dt = tip_cod(cs, tip.crack, tip.end)
@@ -421,13 +428,23 @@ class CrackScene:
         tips = [t for t in self.tips if t.criterion is not None and not t.stopped]
         if not tips:
             return []
-        rows = []
-        for tip, row in zip(tips, self.tip_results(sim, tips=tips)):
+        # a check runs every step or so: with criteria that read J columns only, the
+        # rest of a row is computed for a tip that grows only
+        lean = all(t.criterion.row_keys is not None and set(t.criterion.row_keys) <= J_COLUMNS
+                   for t in tips)
+        size = self.jcontour_size
+        self.update_edge_history()
+        fields = self.j_fields(sim, self._contour_window(sim, tips, size))
+        growing = []
+        for tip in tips:
+            row = self._tip_row(sim, fields, tip, size, lean=lean)
             if row["error"]:
                 continue
+            if tip.criterion.should_grow(row, sim.materials[tip.material]):
+                growing.append((tip, self._tip_row(sim, fields, tip, size) if lean else row))
+        rows = []
+        for tip, row in growing:
             material = sim.materials[tip.material]
-            if not tip.criterion.should_grow(row, material):
-                continue
             tip.grown += 1
             jc = tip.criterion.critical_J(material)
             row["R_J_m2"] = jc + row["W_B_root_J_m2"] - row["W_B_rec_root_J_m2"]

@@ -6,6 +6,10 @@ results (``cracks.csv`` columns: ``J_tip_J_m2``, ``J_ff_J_m2``, ``KI_MPa_sqrt_m`
 and ``material`` the tip material plugin instance, whose parameters carry the
 fracture properties (``JIc``, ``JIIc`` in J/m^2, ``KIc``, ``KIIc`` in MPa sqrt(m)).
 ``critical_J(material)`` gives the J_tip,c the framework uses in R (seed Eq 15).
+``row_keys`` names the columns ``should_grow`` reads, when they are all J columns
+(``J_contour_J_m2``, ``J_tip_J_m2``, ``J_ff_J_m2``, ``W_B_*``): a check then skips
+the rest of the row (K, the notch CODs), which it computes only for a tip that grows.
+None (the default) gives every check the whole row.
 
 The framework owns the rest (NairnMPM's rules, shared notes JINTEGRAL.md section 8):
 when to check, the growth direction and length, the new crack particle and the
@@ -19,6 +23,7 @@ import math
 class PropagationCriterion:
     name = "criterion"
     nairn_type: int | None = None
+    row_keys: tuple[str, ...] | None = None
 
     def should_grow(self, tip: dict, material) -> bool:  # pragma: no cover - abstract
         raise NotImplementedError

@@ -11,6 +11,7 @@ from .base import PropagationCriterion
 class CriticalEnergyRelease(PropagationCriterion):
     name = "CriticalERR"
     nairn_type = 7
+    row_keys = ("J_tip_J_m2",)
 
     def critical_J(self, material) -> float:
         v = getattr(material.params, "JIc", None)
@@ -31,6 +32,7 @@ class NoPropagation(PropagationCriterion):
     """Criterion 0: the crack does not grow."""
     name = "None"
     nairn_type = 0
+    row_keys = ()
 
     def should_grow(self, tip: dict, material) -> bool:
         return False
