@@ -304,13 +304,18 @@ class CrackScene:
         sizes = list(sizes or [self.jcontour_size])
         if not tips:
             return []
-        self.update_edge_history()
-        fields = self.j_fields(sim, self._contour_window(sim, tips, max(sizes)))
+        fields = self._check_fields(sim, tips, max(sizes))
         rows = []
         for tip in tips:
             for size in sizes:
                 rows.append(self._tip_row(sim, fields, tip, int(size)))
         return rows
+
+    def _check_fields(self, sim, tips, size: int) -> NodalFields:
+        """What every J evaluation starts with: the edge maxima raised to now, and J's
+        nodal fields around these tips for contours up to ``size`` cells."""
+        self.update_edge_history()
+        return self.j_fields(sim, self._contour_window(sim, tips, size))
 
     def j_fields(self, sim, window) -> NodalFields:
         """J's nodal fields over ``window`` with the crack sides the time step assigned.
@@ -433,8 +438,7 @@ class CrackScene:
         lean = all(t.criterion.row_keys is not None and set(t.criterion.row_keys) <= J_COLUMNS
                    for t in tips)
         size = self.jcontour_size
-        self.update_edge_history()
-        fields = self.j_fields(sim, self._contour_window(sim, tips, size))
+        fields = self._check_fields(sim, tips, size)
         growing = []
         for tip in tips:
             row = self._tip_row(sim, fields, tip, size, lean=lean)
