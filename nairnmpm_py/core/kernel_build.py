@@ -5,12 +5,14 @@ from the task list (``core/tasks.py``).
 Numba caches a compiled function by its source file, and cannot cache a kernel that
 receives a jitted function as an argument.  So for each scene kind we write a copy of
 ``step_kernels.py`` into a cache folder, with the default material import replaced by
-a dispatcher over exactly the scene's updates, and append the driver.  A scene with
+a dispatcher over exactly the scene's updates.  A scene with
 cracks also gets a copy of the crack tasks' template (``tasks.CRACKS``) with its
 traction-law envelopes, imported by the step copy.  A copy is written once per
 distinct source; later runs load it and its Numba cache, which makes warm starts
 fast.  The condition expressions are a small module of their own, which the kernels
 call through its address (``expressions``), so they never change the step's copy.
+The driver is a module of its own too (``load_driver``): it calls the tasks through
+their addresses (``task_addresses``, ``core/linking``), so it holds no scene's code.
 """
 from __future__ import annotations
 
@@ -20,17 +22,20 @@ import os
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from . import step_kernels
 from .expressions import condition_module_source
-from .tasks import CRACKS, driver_source, step_tasks
+from .linking import address_of
+from .tasks import CRACKS, driver_source, step_tasks, task_list
 
 MARKER = "# KERNEL-MATERIALS"
 SHAPE_MARKER = "# KERNEL-SHAPE"
 FIELDS_MARKER = "# KERNEL-FIELDS"
 MULTI_FIELD_MARKER = "# KERNEL-MULTI-FIELD"
 UPDATE_STRESS_MARKER = "# KERNEL-UPDATE-STRESS"
+PARALLEL_MARKER = "# KERNEL-PARALLEL"
 
 
 def cache_dir() -> Path:
@@ -100,11 +105,12 @@ def condition_functions(expressions: dict[int, str]) -> tuple[int, np.ndarray]:
 
 
 def load_kernels(update_functions: list[str], shape: int = 1,
-                 crack_envelopes: list[str] | None = None, update_stress: bool = True):
+                 crack_envelopes: list[str] | None = None, update_stress: bool = True,
+                 parallel: bool = True):
     """The kernel module for a scene whose materials use these update functions (in
     order), with one kind of shape function (0 linear, 1 uGIMP) and, for a scene
     with cracks, the traction envelopes of its laws ("module:function",
-    index = kind in the law tables).  The module's ``advance`` is the step driver.
+    index = kind in the law tables).  ``task_addresses`` gives its tasks to the driver.
     ``update_stress`` False (USF, USL+, USAVG+: the particle update never updates
     stresses) leaves the material updates out of the particle update's code.
     (A build without Numba's parallel loops for one-thread scenes compiles a third
@@ -122,6 +128,9 @@ def load_kernels(update_functions: list[str], shape: int = 1,
                                "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x",
                                "nairnmpm_py.core.expressions:x"]
     with_cracks = crack_envelopes is not None
+    if not parallel and not with_cracks:
+        _replace_marked(lines, PARALLEL_MARKER, "PARALLEL = False  # one chunk, serial loops",
+                        where)
     if with_cracks:
         cracks = _load_crack_tasks(shape, crack_envelopes)
         crack_names = sorted({t.name for group in step_tasks(True) for t in group
@@ -131,8 +140,30 @@ def load_kernels(update_functions: list[str], shape: int = 1,
                         + ", ".join(crack_names), where)
         _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
         refs.append(cracks.__name__ + ":x")
-    source = "\n".join(lines) + "\n\n" + driver_source(with_cracks)
-    return _load_source(source, "nairnmpm_kernels", refs)
+    return _load_source("\n".join(lines) + "\n", "nairnmpm_kernels", refs)
+
+
+def load_driver(with_cracks: bool):
+    """The step driver module (``advance``, ``advance_profiled``) of scenes with or
+    without cracks."""
+    refs = ["nairnmpm_py.core.step_kernels:x", "nairnmpm_py.core.linking:x",
+            "nairnmpm_py.core.cycles:x", "nairnmpm_py.core.state:x"]
+    return _load_source(driver_source(with_cracks), "nairnmpm_driver", refs)
+
+
+def task_addresses(kernels, with_cracks: bool, bundles: tuple) -> np.ndarray:
+    """The driver's ``T``: the address of each task of ``task_list`` in the kernel
+    module ``kernels``, compiled (or loaded from the cache) for the types of these
+    bundles (P, G, C, K, S); a wrapper's entry is its pass's."""
+    P, G, C, K, S = (numba.typeof(b) for b in bundles)
+    out = []
+    for task in task_list(with_cracks):
+        if task.runs:
+            argtypes = (P, G, K, S) + kernels.PASS_ARGS[task.runs]
+            out.append(address_of(getattr(kernels, task.runs), argtypes))
+        else:
+            out.append(address_of(getattr(kernels, task.name), (P, G, C, K, S)))
+    return np.array(out, dtype=np.int64)
 
 
 def _dependency_text(refs: list[str]) -> str:
@@ -171,7 +202,8 @@ def _load_source(source: str, prefix: str, refs: list[str]):
 TRACTION_MARKER = "# KERNEL-TRACTION"
 CRACK_DEPENDENCIES = ["nairnmpm_py.cracks.crossing:x", "nairnmpm_py.cracks.chords:x",
                       "nairnmpm_py.cracks.crack_lists:x", "nairnmpm_py.cracks.bundle:x",
-                      "nairnmpm_py.core.state:x", "nairnmpm_py.core.grid_ops:x"]
+                      "nairnmpm_py.core.state:x", "nairnmpm_py.core.grid_ops:x",
+                      "nairnmpm_py.core.step_kernels:x"]
 
 
 def _traction_source(functions: list[str]) -> str:

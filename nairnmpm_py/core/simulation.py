@@ -17,7 +17,8 @@ import numpy as np
 from ..errors import SimulationUnstable
 from .conditions import GRID_VELOCITY, ConditionRecord, Conditions
 from .grid import Grid
-from .kernel_build import condition_functions, load_kernels, material_table
+from .kernel_build import (condition_functions, load_driver, load_kernels, material_table,
+                           task_addresses)
 from .particles import Particles
 from .profile import StepProfile
 from .tasks import periodic_task
@@ -74,7 +75,9 @@ class Simulation:
     def __post_init__(self):
         self.time = 0.0
         self.step = 0
-        self.kernels = None
+        self.kernels = None         # the scene's step tasks (kernel_build.load_kernels)
+        self.driver = None          # the step driver (kernel_build.load_driver)
+        self.task_at = None         # the driver's task addresses (kernel_build.task_addresses)
         self._update_stress = True  # the kernels built have the particle update's stress update
         self.profiler = None        # a StepProfile while a run is profiled
         self.grid_current = False   # the grid holds the particles' current extrapolation
@@ -130,7 +133,10 @@ class Simulation:
         envelopes = self.cracks.envelope_functions() if self.cracks is not None else None
         # the particle update updates stresses only in USL- and USAVG-
         self._update_stress = stress_split(self.method, self.post_extrapolate, 1.0)[2] > 0.0
-        self.kernels = load_kernels(functions, self.shape, envelopes, self._update_stress)
+        self.kernels = load_kernels(functions, self.shape, envelopes, self._update_stress,
+                                    self.parallel)
+        self.driver = load_driver(envelopes is not None)
+        self.task_at = None         # compiled at the first step, for the bundles' types
         address, self.fconst = condition_functions(expressions)
         self.faddr = np.array([address], dtype=np.int64)
         self.nch = threads if self.parallel else 1
@@ -244,18 +250,25 @@ class Simulation:
         changed from outside between calls need ``grid_current = False`` first."""
         self.prepare()
         p = self.particles
-        # one chunk: no thread pool, no barriers (asked only then: the two calls cost
-        # about 10 us, a propagation check calls the driver every step)
-        threads = numba.get_num_threads() if not self.parallel else 0
+        # one chunk of a build with parallel loops (a scene with cracks): no thread pool,
+        # no barriers (asked only then: the two calls cost about 10 us, a propagation
+        # check calls the driver every step; a one-chunk build without cracks has no
+        # parallel loops)
+        threads = numba.get_num_threads() if not self.parallel and self.cracks else 0
         if threads:
             numba.set_num_threads(1)
         try:
             self.clock[0] = self.time
+            bundles = self.bundles()
+            if self.task_at is None:
+                self.task_at = task_addresses(self.kernels, self.cracks is not None, bundles)
             if self.profiler is None:
-                done = self.kernels.advance(*self.bundles(), nsteps, self.grid_current, flush)
+                done = self.driver.advance(*bundles, self.task_at, nsteps, self.grid_current,
+                                           flush)
             else:
-                done = self.kernels.advance_profiled(*self.bundles(), nsteps, self.grid_current,
-                                                     flush, self.profiler.cycles)
+                done = self.driver.advance_profiled(*bundles, self.task_at, nsteps,
+                                                    self.grid_current, flush,
+                                                    self.profiler.cycles)
         finally:
             if threads:
                 numba.set_num_threads(threads)

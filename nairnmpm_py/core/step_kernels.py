@@ -31,6 +31,14 @@ numba#10338); and a body that calls a function taking the bundles ran the beam
 1.6-2.2x slower.  Reading an array out of a tuple costs reference counting at each
 access, so nothing a particle loop reads for every particle comes from a tuple.
 
+A scene that runs as one chunk and has no cracks builds with ``PARALLEL`` False: no
+parallel loops, which Numba compiles as separate functions through a long pipeline
+(the beam compiled in 20 s instead of 34), and no reference counting (``NRT``).
+Without parallel loops Numba counts references to each array an inlined helper
+receives, at every particle, and those atomic counts ran the beam 1.4-1.6x slower;
+these tasks allocate nothing, so nothing needs counting.  (The crack tasks allocate
+scratch arrays, so a scene with cracks keeps the parallel build on one chunk too.)
+
 ``FAST`` allows reassociation and fused multiply-adds but keeps NaN and infinity
 semantics, so blow-ups are still caught.
 """
@@ -39,6 +47,7 @@ from __future__ import annotations
 import math
 
 from numba import njit, prange
+from numba.types import boolean, float64
 
 from nairnmpm_py.core.grid_ops import accelerate_node
 from nairnmpm_py.core.shape import weights_1d
@@ -46,11 +55,14 @@ from nairnmpm_py.core.state import (GM, GPX, GPY, GFX, GFY, CLOCK_T, CLOCK_PENDI
                                     STATUS_NONFINITE, STATUS_LEFT_GRID, STATUS_RUNAWAY)
 from nairnmpm_py.core.material_dispatch_default import material_update  # KERNEL-MATERIALS
 from nairnmpm_py.core.expressions import call_condition
+from nairnmpm_py.core.linking import call_task
 from nairnmpm_py.core.single_field import assign_and_scatter, field_lists  # KERNEL-FIELDS
 
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
 MULTI_FIELD = False  # KERNEL-MULTI-FIELD: more than one velocity field per node
 UPDATE_STRESS = True  # KERNEL-UPDATE-STRESS: the particle update updates stresses (USL- / USAVG-)
+PARALLEL = True  # KERNEL-PARALLEL: loops on threads (False: a one-chunk build without cracks)
+NRT = PARALLEL  # reference counting: only a build with parallel loops needs it (docstring)
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
 FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
 
@@ -65,7 +77,7 @@ def bc_active(style, t0, t):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=NRT)
 def bc_value(C, r, t, x, y, q):
     """Value of boundary condition record r at time t (ms).
 
@@ -269,7 +281,7 @@ def face_node(pos, lp, F, geom, nny, p, face, m):
     return i + a, j + b, 0.5 * (fx if a == 1 else 1.0 - fx) * (fy if b == 1 else 1.0 - fy)
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def scatter_loads(P, G, C, K, S):
     """Clear the grid forces, then the particle loads (N) at this time onto the grid,
     in the field the particle uses at each node; ``C.pload`` keeps them for the work,
@@ -310,7 +322,7 @@ def scatter_loads(P, G, C, K, S):
                 g[field_at(K.cut, K.vfld, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def load_work(P, G, C, K, S):
     """Work (mJ) of each particle load over the step just taken."""
     for q in range(C.pbc_part.size):
@@ -319,7 +331,7 @@ def load_work(P, G, C, K, S):
 
 
 # ---- velocity conditions ---------------------------------------------------------------
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def momentum_conditions(P, G, C, K, S):
     """Impose velocity conditions on the extrapolated momenta of every field, then
     the velocities of the conditioned nodes.
@@ -366,7 +378,7 @@ def momentum_conditions(P, G, C, K, S):
                     gv[f, 1, k] = 0.0
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def velocity_conditions(P, G, C, K, S):
     """Impose v(t+dt) on conditioned nodes in every field; the force that takes is
     the reaction (summed over the fields)."""
@@ -497,7 +509,7 @@ def _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, mat, F, stress, hi
                         plane_stress)
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
     """Each particle's velocity gradient from its own fields' grid velocities, its
     stress updates (``_stress_updates``), and with ``scatter`` its internal forces
@@ -542,28 +554,33 @@ def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
             _internal_forces(buf, p, r, i0, j0, nnx, vfld, cut, sxx, syy, sxy)
 
 
+# The passes run as tasks through driver-side wrappers (inlined into the driver): a
+# wrapper gets its pass's address (``core/linking``) and the pass's extra arguments
+# after (P, G, K, S), whose types ``PASS_ARGS`` names for compiling it.
+PASS_ARGS = {"_stress_pass": (float64, float64, boolean), "_particle_pass": (boolean,)}
+
+
 @njit(cache=True, inline="always")
-def stress_and_forces(P, G, C, K, S):
+def stress_and_forces(P, G, C, K, S, stress_pass):
     """Stress update (USF / USAVG first half, plus a carried-over USAVG+ / USL+ last
     half) fused with the internal forces into the chunk buffers."""
     pending = S.clock[CLOCK_PENDING]
     S.clock[CLOCK_PENDING] = 0.0
-    _stress_pass(P, G, K, S, pending, S.dt_first, S.nch > 0)   # a runtime True (see flush)
+    call_task(stress_pass, (P, G, K, S, pending, S.dt_first, S.nch > 0))  # a runtime True
 
 
 @njit(cache=True, inline="always")
-def flush_stress(P, G, C, K, S):
+def flush_stress(P, G, C, K, S, stress_pass):
     """Apply a carried USAVG+ / USL+ stress half now (before stresses or energies are
     read, or when a run stops)."""
     pending = S.clock[CLOCK_PENDING]
     if pending > 0.0:
         S.clock[CLOCK_PENDING] = 0.0
-        # a runtime False: a literal would make Numba compile the whole pass twice
-        _stress_pass(P, G, K, S, 0.0, pending, S.nch < 0)
+        call_task(stress_pass, (P, G, K, S, 0.0, pending, S.nch < 0))   # a runtime False
 
 
 # ---- grid ------------------------------------------------------------------------------
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def reduce_forces(P, G, C, K, S):
     """Add the chunks' internal forces of field 0 to the grid forces (the loads)."""
     g = G.g
@@ -579,7 +596,7 @@ def reduce_forces(P, G, C, K, S):
         g[0, GFY, k] += fy
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def accelerate(P, G, C, K, S):
     """Field 0's accelerations and updated velocities on every node."""
     dt = S.dt
@@ -591,7 +608,7 @@ def accelerate(P, G, C, K, S):
         accelerate_node(g, ga, gvn, 0, k, dt, mass_tol)
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def reduce_extrapolation(P, G, C, K, S):
     """Sum the chunks' mass and momentum of field 0 and its velocities (before
     conditions)."""
@@ -672,7 +689,7 @@ def _scatter_particle(buf, p, r, i0, j0, geom, m, x, y, vx, vy, vfld, cut, cnear
     return conflicts
 
 
-@njit(cache=True, parallel=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
 def _particle_pass(P, G, K, S, move):
     """With ``move``: grid -> particles (FLIP velocity and position with grid and
     particle damping, as NairnMPM applies them; the USL- / USAVG- stress update).
@@ -771,22 +788,22 @@ def _particle_pass(P, G, K, S, move):
 
 
 @njit(cache=True, inline="always")
-def weights_and_mass(P, G, C, K, S):
+def weights_and_mass(P, G, C, K, S, particle_pass):
     """Weights of every particle (cached) and their mass and momentum on the grid."""
-    _particle_pass(P, G, K, S, S.nch < 0)   # a runtime False (see flush_stress)
+    call_task(particle_pass, (P, G, K, S, S.nch < 0))   # a runtime False
 
 
 # ---- grid -> particles -----------------------------------------------------------------
 @njit(cache=True, inline="always")
-def update_and_extrapolate(P, G, C, K, S):
+def update_and_extrapolate(P, G, C, K, S, particle_pass):
     """Grid -> particles, then each particle's new weights and its mass and momentum
     back to the grid (the next extrapolation: in every method positions and
     velocities do not change in between)."""
-    _particle_pass(P, G, K, S, S.nch > 0)   # a runtime True
+    call_task(particle_pass, (P, G, K, S, S.nch > 0))   # a runtime True
 
 
 # ---- bookkeeping -----------------------------------------------------------------------
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def advance_clock(P, G, C, K, S):
     """The step is taken: the time moves on, and USL+ / USAVG+ carry the last stress
     half into the next stress pass (it has the same velocity gradient)."""
@@ -795,7 +812,7 @@ def advance_clock(P, G, C, K, S):
         S.clock[CLOCK_PENDING] = S.dt_last
 
 
-@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
 def check_status(P, G, C, K, S):
     """The first chunk's bad particle (NaN or runaway), else too many particles that
     tried to leave the grid, into ``S.status``."""

@@ -5,7 +5,9 @@ Each entry names the task, the module that holds it and what it does.  Entries m
 ``cracks/``); a scene without cracks never loads them.  ``kernel_build`` composes the
 fused Numba driver from these lists (``driver_source``), so the order lives here and
 nowhere else.  Every step task is a jitted ``task(P, G, C, K, S)`` over the state
-bundles of ``core/state``.
+bundles of ``core/state``, compiled on its own and called by the driver through its
+address (``core/linking``), or a driver-side wrapper ``task(P, G, C, K, S, address)``
+of one of the particle passes (``runs``).
 
 Periodic work runs between calls of the driver, at its own cadence (``PERIODIC``).
 """
@@ -25,6 +27,7 @@ class Task:
     does: str
     cracks: bool = False   # only in scenes with cracks
     stops: bool = False    # may set a status that ends the run at once
+    runs: str = ""         # a wrapper inlined into the driver: the pass it calls
 
 
 # the particles' mass and momentum on the grid, when the grid is not current (first
@@ -32,7 +35,8 @@ class Task:
 EXTRAPOLATE = (
     Task("crack_lists", CRACKS, "chords near each cell, crack slots of each node", cracks=True,
          stops=True),
-    Task("weights_and_mass", CORE, "shape functions; mass and momentum to each particle's fields"),
+    Task("weights_and_mass", CORE, "shape functions; mass and momentum to each particle's fields",
+         runs="_particle_pass"),
     Task("reduce_extrapolation", CORE, "sum the chunks' field 0; velocities"),
     Task("reduce_crack_fields", CRACKS, "sum the other fields and contact rows at crack nodes", cracks=True),
     Task("contact_momenta", CRACKS, "frictionless contact on the extrapolated momenta", cracks=True),
@@ -41,7 +45,8 @@ EXTRAPOLATE = (
 
 STEP = (
     Task("scatter_loads", CORE, "clear forces; particle loads and tractions onto the grid"),
-    Task("stress_and_forces", CORE, "velocity gradient, stress update, internal forces"),
+    Task("stress_and_forces", CORE, "velocity gradient, stress update, internal forces",
+         runs="_stress_pass"),
     Task("reduce_forces", CORE, "sum the chunks' field-0 forces"),
     Task("reduce_crack_forces", CRACKS, "sum the other fields' forces at crack nodes", cracks=True),
     Task("crack_tractions", CRACKS, "traction laws pull the crack surfaces together", cracks=True),
@@ -53,7 +58,8 @@ STEP = (
          stops=True),
     Task("crack_lists", CRACKS, "chords and crack nodes of the moved cracks", cracks=True,
          stops=True),
-    Task("update_and_extrapolate", CORE, "grid to particles; their mass and momentum back"),
+    Task("update_and_extrapolate", CORE, "grid to particles; their mass and momentum back",
+         runs="_particle_pass"),
     Task("load_work", CORE, "work of the particle loads"),
     Task("advance_clock", CORE, "t += dt; carry the USAVG+ / USL+ stress half"),
     Task("clear_crack_nodes", CRACKS, "empty the other fields at the old crack nodes", cracks=True),
@@ -66,7 +72,7 @@ STEP = (
 
 # after the last step of a call that is followed by output, and when a run stops
 FINISH = (
-    Task("flush_stress", CORE, "apply the carried USAVG+ / USL+ stress half"),
+    Task("flush_stress", CORE, "apply the carried USAVG+ / USL+ stress half", runs="_stress_pass"),
 )
 
 
@@ -110,19 +116,27 @@ def step_tasks(with_cracks: bool) -> tuple[tuple[Task, ...], tuple[Task, ...], t
 
 
 ARGS = "P, G, C, K, S"
-JIT = "@_njit_driver(cache=True, error_model='numpy')"
+# no reference counting in the driver: it only passes the bundles on (the tasks own
+# none of their arrays), and counting each of their ~60 arrays at every call doubled
+# the driver's compile time
+JIT = "@_njit_driver(cache=True, error_model='numpy', _nrt=False)"
 
 
 def _calls(tasks, indent: str, profile: bool, index: dict, stop: str) -> list[str]:
-    """Calls of ``tasks``; after a task that may stop the run, ``stop`` (a line that
-    leaves the loop) or, with ``stop`` empty, the rest nested under a status test."""
+    """Calls of ``tasks`` (task i of ``task_list`` at address ``T[i]``); after a task
+    that may stop the run, ``stop`` (a line that leaves the loop) or, with ``stop``
+    empty, the rest nested under a status test."""
     out = []
     for task in tasks:
+        i = index[task.name]
         if profile:
             out.append(f"{indent}_c0 = _cycles()")
-        out.append(f"{indent}{task.name}({ARGS})")
+        if task.runs:
+            out.append(f"{indent}{task.name}({ARGS}, T[{i}])")
+        else:
+            out.append(f"{indent}_call(T[{i}], ({ARGS}))  # {task.name}")
         if profile:
-            out.append(f"{indent}prof[{index[task.name]}] += _cycles() - _c0")
+            out.append(f"{indent}prof[{i}] += _cycles() - _c0")
         if task.stops:
             if stop:
                 out += [f"{indent}if S.status[0] != 0:", f"{indent}    {stop}"]
@@ -134,29 +148,36 @@ def _calls(tasks, indent: str, profile: bool, index: dict, stop: str) -> list[st
     return out
 
 
-def profile_rows(with_cracks: bool) -> list[str]:
-    """Task names in the order of the profile array (each name once)."""
-    names = []
+def task_list(with_cracks: bool) -> list[Task]:
+    """Each task of the step once, in the order of the driver's address array ``T``
+    and of the profile array."""
+    seen = {}
     for group in step_tasks(with_cracks):
         for t in group:
-            if t.name not in names:
-                names.append(t.name)
-    return names
+            seen.setdefault(t.name, t)
+    return list(seen.values())
+
+
+def profile_rows(with_cracks: bool) -> list[str]:
+    """Task names in the order of the profile array (each name once)."""
+    return [t.name for t in task_list(with_cracks)]
 
 
 def driver_source(with_cracks: bool) -> str:
-    """Source of the fused driver for the generated kernel module: ``advance`` (and
-    ``advance_profiled``, which also counts each task's clock cycles into ``prof``,
-    indexed as ``profile_rows``).  It expects every task name in its namespace.
-    One function each: Numba links every callee's code into its caller and optimizes
-    it again, so each extra driver level would cost seconds of compiling."""
+    """Source of the step driver: ``advance`` (and ``advance_profiled``, which also
+    counts each task's clock cycles into ``prof``, indexed as ``profile_rows``).  It
+    calls the tasks through their addresses ``T`` (``task_list`` order), so it holds
+    no task's code and one compiled driver serves every scene with these bundles."""
     extrapolate, step, finish = step_tasks(with_cracks)
     index = {name: i for i, name in enumerate(profile_rows(with_cracks))}
+    wrappers = sorted({t.name for group in (extrapolate, step, finish) for t in group if t.runs})
     lines = ["from numba import njit as _njit_driver",
-             "from nairnmpm_py.core.cycles import cycles as _cycles"]
+             "from nairnmpm_py.core.cycles import cycles as _cycles",
+             "from nairnmpm_py.core.linking import call_task as _call",
+             f"from {CORE} import {', '.join(wrappers)}"]
     for suffix, profile in (("", False), ("_profiled", True)):
         extra = ", prof" if profile else ""
-        lines += ["", "", JIT, f"def advance{suffix}({ARGS}, nsteps, resume, flush{extra}):",
+        lines += ["", "", JIT, f"def advance{suffix}({ARGS}, T, nsteps, resume, flush{extra}):",
                   '    """Up to nsteps steps, extrapolating first unless ``resume``; returns the',
                   '    steps taken (S.status says why it stopped early)."""',
                   "    S.status[0] = 0",
