@@ -20,11 +20,12 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
 from pydantic import ValidationError
 
 from .. import plugins
-from . import rcurve as rc
+
+# the theory (through scipy) and matplotlib are imported where used: every command
+# builds this parser, and importing them here cost ``nairnmpm run`` 1.8 s each time
 
 EXIT_OK, EXIT_INPUT = 0, 2
 
@@ -120,6 +121,7 @@ def build_law(name: str, params: list[str]):
 
 def theory_table(law, J_tip_c: float, mode="I", points: int = 101) -> dict[str, np.ndarray]:
     """Columns of the theory table on a COD grid 0..delta_c (units in the names)."""
+    from . import rcurve as rc
     env = law.mode(mode)
     d = np.linspace(0.0, env.delta_c, max(points, 2))
     table = {
@@ -169,6 +171,7 @@ def _theory(args) -> int:
 
 # ---- fig5 -----------------------------------------------------------------------------------
 def _fig5(args) -> int:
+    from . import rcurve as rc
     curves = rc.fig5_curves()
     plot_fig5(curves, args.out)
     print(f"wrote {args.out}")
@@ -183,6 +186,7 @@ def _fig5(args) -> int:
 
 # ---- invert ---------------------------------------------------------------------------------
 def _invert(args) -> int:
+    from . import rcurve as rc
     cols = read_csv(args.csv, ("delta_mm", "R_J_m2"))
     d, R = cols["delta_mm"], cols["R_J_m2"]
     order = np.argsort(d)
@@ -211,6 +215,7 @@ def _invert(args) -> int:
 # ---- area method ------------------------------------------------------------------------------
 def area_table(d, F, a, B: float, smoothing="gcv"):
     """Per-row table of the area method plus the spline fit and the Eq 25 points."""
+    from . import rcurve as rc
     fit = rc.R_from_area_method(d, F, a, B, smoothing=smoothing)
     a_mid, R_disc = rc.discrete_area_method(d, F, a, B)
     disc_rows = np.full(len(d), np.nan)
@@ -297,6 +302,7 @@ def _write_rows(fh, table: dict[str, np.ndarray]) -> None:
 
 # ---- plots (bare Figure objects: no pyplot, no display needed) ----------------------------------
 def plot_theory(law, table, mode, J_tip_c, path) -> None:
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(11.0, 4.5), layout="constrained")
     ax1, ax2 = fig.subplots(1, 2)
     d = table["delta_mm"]
@@ -316,6 +322,7 @@ def plot_theory(law, table, mode, J_tip_c, path) -> None:
 
 
 def plot_fig5(curves, path) -> None:
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(6.0, 4.5), layout="constrained")
     ax = fig.subplots()
     x = curves["x"]
@@ -332,6 +339,7 @@ def plot_fig5(curves, path) -> None:
 
 
 def plot_inversion(table, path) -> None:
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(11.0, 4.5), layout="constrained")
     ax1, ax2 = fig.subplots(1, 2)
     ax1.plot(table["delta_mm"], table["R_J_m2"], "k.-")
@@ -347,6 +355,7 @@ def plot_inversion(table, path) -> None:
 
 def plot_area(table, fit, discrete, path) -> None:
     """Fig 11 style: A force and crack length against displacement, B U(a), C R(a)."""
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(15.0, 4.5), layout="constrained")
     ax1, ax2, ax3 = fig.subplots(1, 3)
     ax1.plot(table["d_mm"], table["F_N"], "k-")

@@ -4,11 +4,12 @@
 has the signature ``task(P, G, C, K, S)`` over the state bundles of ``core/state``.
 
 This file is a template as well as a module: ``kernel_build`` copies it into a cache
-folder with the scene's material dispatcher, shape functions (``KIND``), style-6
-condition expressions and velocity fields filled in at the marked lines, and appends
-the driver it composes from the task list, so the stress update of any material
-plugin is inlined in the particle loops and everything stays ``cache=True``.
-Imported directly it runs uGIMP with the isotropic material and one field.
+folder with the scene's material dispatcher, shape functions (``KIND``), velocity
+fields and build flags filled in at the marked lines, so the stress update of any
+material plugin is inlined in the particle loops and everything stays
+``cache=True``.  The driver, composed from the task list, is a module of its own that
+calls these tasks through their addresses (``core/linking``).  Imported directly this
+file runs uGIMP with the isotropic material and one field.
 
 Fields: a scene without cracks has one velocity field per node (``MULTI_FIELD``
 False: every field index below is the constant 0 and compiles away).  A scene with
