@@ -66,6 +66,10 @@ PARALLEL = True  # KERNEL-PARALLEL: loops on threads (False: a one-chunk build w
 NRT = PARALLEL  # reference counting: only a build with parallel loops needs it (docstring)
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
 FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
+# how every task compiles (no Python entry point: only the driver calls them), and the
+# particle and node loops over chunks or nodes
+TASK = dict(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+PARALLEL_TASK = dict(TASK, parallel=PARALLEL, fastmath=FAST)
 
 
 # ---- condition values ----------------------------------------------------------------
@@ -282,7 +286,7 @@ def face_node(pos, lp, F, geom, nny, p, face, m):
     return i + a, j + b, 0.5 * (fx if a == 1 else 1.0 - fx) * (fy if b == 1 else 1.0 - fy)
 
 
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def scatter_loads(P, G, C, K, S):
     """Clear the grid forces, then the particle loads (N) at this time onto the grid,
     in the field the particle uses at each node; ``C.pload`` keeps them for the work,
@@ -323,7 +327,7 @@ def scatter_loads(P, G, C, K, S):
                 g[field_at(K.cut, K.vfld, p, b * NA + a), row_c, row + a] += wq[3 + b] * wq[a] * f
 
 
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def load_work(P, G, C, K, S):
     """Work (mJ) of each particle load over the step just taken."""
     for q in range(C.pbc_part.size):
@@ -332,7 +336,7 @@ def load_work(P, G, C, K, S):
 
 
 # ---- velocity conditions ---------------------------------------------------------------
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def momentum_conditions(P, G, C, K, S):
     """Impose velocity conditions on the extrapolated momenta of every field, then
     the velocities of the conditioned nodes.
@@ -379,7 +383,7 @@ def momentum_conditions(P, G, C, K, S):
                     gv[f, 1, k] = 0.0
 
 
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def velocity_conditions(P, G, C, K, S):
     """Impose v(t+dt) on conditioned nodes in every field; the force that takes is
     the reaction (summed over the fields)."""
@@ -510,7 +514,7 @@ def _stress_updates(p, dt_pre, dt_stress, L00, L01, L10, L11, mat, F, stress, hi
                         plane_stress)
 
 
-@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(**PARALLEL_TASK)
 def _stress_pass(P, G, K, S, dt_pre, dt_stress, scatter):
     """Each particle's velocity gradient from its own fields' grid velocities, its
     stress updates (``_stress_updates``), and with ``scatter`` its internal forces
@@ -581,7 +585,7 @@ def flush_stress(P, G, C, K, S, stress_pass):
 
 
 # ---- grid ------------------------------------------------------------------------------
-@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(**PARALLEL_TASK)
 def reduce_forces(P, G, C, K, S):
     """Add the chunks' internal forces of field 0 to the grid forces (the loads)."""
     g = G.g
@@ -597,7 +601,7 @@ def reduce_forces(P, G, C, K, S):
         g[0, GFY, k] += fy
 
 
-@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(**PARALLEL_TASK)
 def accelerate(P, G, C, K, S):
     """Field 0's accelerations and updated velocities on every node."""
     dt = S.dt
@@ -609,7 +613,7 @@ def accelerate(P, G, C, K, S):
         accelerate_node(g, ga, gvn, 0, k, dt, mass_tol)
 
 
-@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(**PARALLEL_TASK)
 def reduce_extrapolation(P, G, C, K, S):
     """Sum the chunks' mass and momentum of field 0 and its velocities (before
     conditions)."""
@@ -690,7 +694,7 @@ def _scatter_particle(buf, p, r, i0, j0, geom, m, x, y, vx, vy, vfld, cut, cnear
     return conflicts
 
 
-@njit(cache=True, parallel=PARALLEL, _nrt=NRT, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
+@njit(**PARALLEL_TASK)
 def _particle_pass(P, G, K, S, move):
     """With ``move``: grid -> particles (FLIP velocity and position with grid and
     particle damping, as NairnMPM applies them; the USL- / USAVG- stress update).
@@ -804,7 +808,7 @@ def update_and_extrapolate(P, G, C, K, S, particle_pass):
 
 
 # ---- bookkeeping -----------------------------------------------------------------------
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def advance_clock(P, G, C, K, S):
     """The step is taken: the time moves on, and USL+ / USAVG+ carry the last stress
     half into the next stress pass (it has the same velocity gradient)."""
@@ -813,7 +817,7 @@ def advance_clock(P, G, C, K, S):
         S.clock[CLOCK_PENDING] = S.dt_last
 
 
-@njit(cache=True, _nrt=NRT, error_model="numpy", no_cpython_wrapper=True)
+@njit(**TASK)
 def check_status(P, G, C, K, S):
     """The first chunk's bad particle (NaN or runaway), else too many particles that
     tried to leave the grid, into ``S.status``."""
