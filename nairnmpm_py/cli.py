@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import shutil
+import signal
 import sys
 from pathlib import Path
 
@@ -116,6 +117,9 @@ def cmd_run(args) -> int:
             bar.refresh()
     if not args.quiet:
         print(_summary(sim), file=sys.stderr)
+    # a job scheduler's SIGTERM stops the run as Ctrl-C does: at the next return to
+    # Python (a fraction of a second), with every output closed and exit 130
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
         status = sim.run(outputs, progress=progress, profile=args.profile)
     except SimulationUnstable as exc:
@@ -128,6 +132,8 @@ def cmd_run(args) -> int:
             bar.close()
         print(f"\ninterrupted; results so far are in {out}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     if bar is not None:
         bar.close()
     if not args.quiet:
