@@ -100,7 +100,11 @@ def cmd_run(args) -> int:
         else:
             print(f"{out}: exists and is not a results folder; not replacing it", file=sys.stderr)
             return EXIT_INPUT
-    out.mkdir(parents=True)
+    try:
+        out.mkdir(parents=True)
+    except OSError as exc:
+        print(f"{out}: cannot create the results folder: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_INPUT
     outputs = default_outputs(out)
     show = not args.quiet and sys.stderr.isatty()
     bar = None
@@ -132,6 +136,12 @@ def cmd_run(args) -> int:
             bar.close()
         print(f"\ninterrupted; results so far are in {out}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OSError as exc:      # a full disk, a folder made unwritable during the run
+        if bar is not None:
+            bar.close()
+        print(f"{exc.filename or out}: cannot write the results: {exc.strerror or exc}; "
+              f"what was written before is in {out}", file=sys.stderr)
+        return EXIT_INPUT
     finally:
         signal.signal(signal.SIGTERM, previous)
     if bar is not None:

@@ -175,3 +175,47 @@ def test_default_results_folder_is_not_overwritten_either(tmp_path, capsys):
     assert (out / "global.csv").exists()
     assert main(["run", str(path), "-q"]) == 2
     assert "--force" in capsys.readouterr().err
+
+
+def test_an_unwritable_results_folder_is_refused_with_exit_2(tmp_path, capsys):
+    path = write(tmp_path, GOOD, "good.xml")
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    out = blocker / "results"      # under a file: no one can create it, root included
+    assert main(["run", str(path), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(out) in err and "cannot create" in err
+    assert blocker.read_text() == "not a folder"
+
+
+def test_a_full_disk_during_the_run_stops_it_with_exit_2_and_keeps_what_was_written(
+        tmp_path, capsys, monkeypatch):
+    import errno
+    from nairnmpm_py.outputs.global_csv import GlobalCsv
+    # a global row every 0.005 ms: ten in the run
+    text = GOOD.replace('<MaxTime units="ms">0.05</MaxTime>', '<MaxTime units="ms">0.05</MaxTime>'
+                        '\n    <GlobalArchiveTime units="ms">0.005</GlobalArchiveTime>')
+    path = write(tmp_path, text, "good.xml")
+    out = tmp_path / "results"
+    real = GlobalCsv.on_global
+    calls = []
+
+    def fills_up(self, sim, row):
+        calls.append(sim.step)
+        if len(calls) > 3:       # the disk fills after three rows
+            raise OSError(errno.ENOSPC, "No space left on device",
+                          str(self.folder / self.filename))
+        real(self, sim, row)
+    monkeypatch.setattr(GlobalCsv, "on_global", fills_up)
+    assert main(["run", str(path), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "No space left on device" in err and "global.csv" in err
+    run = json.loads((out / "run.json").read_text())
+    assert run["exit_status"] == "write_failed"
+    assert 0 < run["steps_taken"] < run["steps_planned"]      # it stopped there
+    rows = (out / "global.csv").read_text().splitlines()
+    assert len(rows) == 1 + 3                  # the header and the rows written before
+    import h5py
+    with h5py.File(out / "archive.h5", "r") as h5:   # closed cleanly
+        assert h5.attrs["exit_status"] == "write_failed"
+        assert len(h5["archives"]) >= 1

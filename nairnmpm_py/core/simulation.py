@@ -373,6 +373,9 @@ class Simulation:
         except KeyboardInterrupt:
             status = {"exit_status": "interrupted"}
             raise
+        except OSError as exc:
+            status = {"exit_status": "write_failed", "message": str(exc)}
+            raise
         finally:
             status["wall_seconds"] = wallclock.perf_counter() - t_wall
             status["steps"] = self.step
@@ -380,9 +383,21 @@ class Simulation:
                 self.profiler.stop()
                 status["profile"] = self.profiler.rows(self.step - step0)
             self.profiler = None
-            for o in outputs:
-                o.end(self, status)
+            self._end_outputs(outputs, status)
         return status
+
+    def _end_outputs(self, outputs, status: dict) -> None:
+        """Close every output, also when one of them cannot write (a full disk): the
+        others still close their files.  The first failure is raised after all, unless
+        the run is already stopping for another reason (that one is reported)."""
+        failed = None
+        for o in outputs:
+            try:
+                o.end(self, status)
+            except OSError as exc:
+                failed = failed or exc
+        if failed is not None and status.get("exit_status") == "done":
+            raise failed
 
     def _emit(self, outputs, archive: bool, glob: bool, timed=None) -> None:
         timed = timed or _untimed
