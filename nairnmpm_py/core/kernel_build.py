@@ -128,7 +128,7 @@ def load_kernels(update_functions: list[str], shape: int = 1,
                                "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x",
                                "nairnmpm_py.core.expressions:x"]
     with_cracks = crack_envelopes is not None
-    if not parallel and not with_cracks:
+    if not parallel:
         _replace_marked(lines, PARALLEL_MARKER, "PARALLEL = False  # one chunk, serial loops",
                         where)
     if with_cracks:

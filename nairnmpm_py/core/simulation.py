@@ -250,10 +250,10 @@ class Simulation:
         changed from outside between calls need ``grid_current = False`` first."""
         self.prepare()
         p = self.particles
-        # one chunk of a build with parallel loops (a scene with cracks): no thread pool,
-        # no barriers (asked only then: the two calls cost about 10 us, a propagation
-        # check calls the driver every step; a one-chunk build without cracks has no
-        # parallel loops)
+        # one chunk of a scene with cracks (its crack-plane moves loop in parallel):
+        # no thread pool, no barriers (asked only then: the two calls cost about 10 us,
+        # a propagation check calls the driver every step; the step's own tasks have no
+        # parallel loops on one chunk)
         threads = numba.get_num_threads() if not self.parallel and self.cracks else 0
         if threads:
             numba.set_num_threads(1)

@@ -32,13 +32,14 @@ numba#10338); and a body that calls a function taking the bundles ran the beam
 1.6-2.2x slower.  Reading an array out of a tuple costs reference counting at each
 access, so nothing a particle loop reads for every particle comes from a tuple.
 
-A scene that runs as one chunk and has no cracks builds with ``PARALLEL`` False: no
-parallel loops, which Numba compiles as separate functions through a long pipeline
-(the beam compiled in 20 s instead of 34), and no reference counting (``NRT``).
-Without parallel loops Numba counts references to each array an inlined helper
-receives, at every particle, and those atomic counts ran the beam 1.4-1.6x slower;
-these tasks allocate nothing, so nothing needs counting.  (The crack tasks allocate
-scratch arrays, so a scene with cracks keeps the parallel build on one chunk too.)
+A scene that runs as one chunk builds with ``PARALLEL`` False: no parallel loops,
+which Numba compiles as separate functions through a long pipeline (the beam
+compiled in 20 s instead of 34, the DCB in 70 s instead of 88), and no reference
+counting (``NRT``).  Without parallel loops Numba counts references to each array an
+inlined helper receives, at every particle, and those atomic counts ran the beam
+1.4-1.6x slower; these tasks allocate nothing, so nothing needs counting.  (The
+crack tasks, which allocate scratch arrays, are compiled on their own with it: the
+driver calls every task through its address.)
 
 ``FAST`` allows reassociation and fused multiply-adds but keeps NaN and infinity
 semantics, so blow-ups are still caught.
@@ -62,7 +63,7 @@ from nairnmpm_py.core.single_field import assign_and_scatter, field_lists  # KER
 KIND = 1  # KERNEL-SHAPE: 0 classic linear, 1 uGIMP
 MULTI_FIELD = False  # KERNEL-MULTI-FIELD: more than one velocity field per node
 UPDATE_STRESS = True  # KERNEL-UPDATE-STRESS: the particle update updates stresses (USL- / USAVG-)
-PARALLEL = True  # KERNEL-PARALLEL: loops on threads (False: a one-chunk build without cracks)
+PARALLEL = True  # KERNEL-PARALLEL: loops on threads (False: a one-chunk build)
 NRT = PARALLEL  # reference counting: only a build with parallel loops needs it (docstring)
 NA = 2 if KIND == 0 else 3  # nodes per axis a particle touches
 FAST = {"contract", "reassoc", "nsz", "arcp", "afn"}
