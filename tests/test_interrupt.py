@@ -27,12 +27,20 @@ def _long_bar(tmp_path: Path) -> Path:
     return path
 
 
+def _default_signals():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_a_signal_stops_the_run_with_exit_130_and_readable_results(tmp_path, signum):
     out = tmp_path / "results"
+    # as from a terminal: a job started in the background inherits SIGINT ignored (and
+    # then rightly ignores Ctrl-C), as pytest's workers may be
     proc = subprocess.Popen([sys.executable, "-m", "nairnmpm_py.cli", "run",
                              str(_long_bar(tmp_path)), "-o", str(out), "--quiet"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_default_signals)
     rows = out / "global.csv"
     deadline = time.monotonic() + STARTUP_S
     # wait until it is stepping: a few global rows written
