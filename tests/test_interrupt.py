@@ -30,6 +30,9 @@ def _long_bar(tmp_path: Path) -> Path:
 def _default_signals():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # a blocked signal stays blocked across exec, and a library in the test process
+    # may have blocked it (a suspect for the SIGINT case below)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
 
 
 # SIGINT passes here (alone, on two workers, in the background, with cold caches) but
