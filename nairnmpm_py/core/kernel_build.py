@@ -125,7 +125,7 @@ def load_kernels(update_functions: list[str], shape: int = 1,
         _replace_marked(lines, UPDATE_STRESS_MARKER, "UPDATE_STRESS = False  # USF / USL+ / USAVG+",
                         where)
     refs = update_functions + ["nairnmpm_py.core.shape:x", "nairnmpm_py.core.grid_ops:x",
-                               "nairnmpm_py.core.state:x", "nairnmpm_py.core.tasks:x",
+                               "nairnmpm_py.core.state:x", "nairnmpm_py.core.linking:x",
                                "nairnmpm_py.core.expressions:x"]
     with_cracks = crack_envelopes is not None
     if not parallel:

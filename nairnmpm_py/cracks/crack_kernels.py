@@ -133,6 +133,8 @@ def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cn
         return _assign_near_crack(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut,
                                   cell, crack_lists, conflicts)
     cut[p] = 0
+    # step_kernels.scatter_mass_momentum's loop, written here because this module's NA
+    # is its own build's (the template's copy would always have uGIMP's 3)
     b0 = buf[0]
     for b in range(NA):
         sy = r[3 + b]
