@@ -135,11 +135,14 @@ def load_kernels(update_functions: list[str], shape: int = 1,
         cracks = _load_crack_tasks(shape, crack_envelopes)
         crack_names = sorted({t.name for group in step_tasks(True) for t in group
                               if t.module == CRACKS})
-        _replace_marked(lines, FIELDS_MARKER,
-                        f"from {cracks.__name__} import assign_and_scatter, field_lists, "
-                        + ", ".join(crack_names), where)
+        # crack tasks of their own modules (no template: nothing of the scene in them)
+        own = sorted({(t.module, t.name) for group in step_tasks(True) for t in group
+                      if t.cracks and t.module != CRACKS})
+        _replace_marked(lines, FIELDS_MARKER, "\n".join(
+            [f"from {cracks.__name__} import assign_and_scatter, field_lists, "
+             + ", ".join(crack_names)] + [f"from {m} import {n}" for m, n in own]), where)
         _replace_marked(lines, MULTI_FIELD_MARKER, "MULTI_FIELD = True  # crack fields", where)
-        refs.append(cracks.__name__ + ":x")
+        refs += [cracks.__name__ + ":x"] + [f"{m}:x" for m, _ in own]
     return _load_source("\n".join(lines) + "\n", "nairnmpm_kernels", refs)
 
 

@@ -24,7 +24,7 @@ from .profile import StepProfile
 from .tasks import periodic_task
 from .shape import LINEAR, UGIMP
 from .state import (N_ROWS, NO_CRACKS, STATUS_CRACK_LEFT_GRID, STATUS_CRACK_LISTS_FULL,
-                    ConditionArrays, GridArrays, ParticleArrays, Settings, stress_split)
+                    STATUS_TIP_CHECK, ConditionArrays, GridArrays, ParticleArrays, Settings, stress_split)
 
 # below this many particles, thread barriers cost more than threads give (a 200-particle
 # bar took 170 s on two busy cores and 0.2 s on one)
@@ -81,6 +81,10 @@ class Simulation:
         self._update_stress = True  # the kernels built have the particle update's stress update
         self.profiler = None        # a StepProfile while a run is profiled
         self.grid_current = False   # the grid holds the particles' current extrapolation
+        # a run lets the step watch its growing tips (``cracks.growth_watch``): the
+        # driver then stops only when a tip may grow (``tip_check_due``)
+        self.watch_growth = False
+        self.tip_check_due = False
         self.couples = None    # particle-load groups with a moment column (global row)
         self.rec_force = np.zeros(len(self.conditions.records))
         self.rec_work = np.zeros(len(self.conditions.records))
@@ -273,9 +277,15 @@ class Simulation:
             if threads:
                 numba.set_num_threads(threads)
         status, bad = int(self.status[0]), int(self.status[1])
+        self.tip_check_due = status == STATUS_TIP_CHECK
+        if self.tip_check_due:
+            status = 0
         self.grid_current = status == 0
         self.step += int(done)
-        self.time += int(done) * self.dt
+        # the step's own clock, summed dt by dt: adding done * dt here made the time's
+        # rounding depend on how the run was cut into driver calls (which follows
+        # the wall clock), so time-driven loads were not reproducible to the bit
+        self.time = float(self.clock[0])
         if status == STATUS_CRACK_LEFT_GRID:
             cs = self.cracks.cracks
             raise SimulationUnstable(
@@ -336,16 +346,20 @@ class Simulation:
                 self.profiler.start()
             scene = self.cracks
             growing = scene is not None and scene.growing
+            self.watch_growth = growing
             while self.step < total:
                 target = min(step_at(next_arch), step_at(next_glob), total, self.step + chunk)
-                if growing:   # stop at every propagation check
+                # without a watch on every growing tip, stop at every propagation check
+                watched = growing and scene.watch_table(self).shape[0] > 0
+                if growing and not watched:
                     target = min(target, (self.step // scene.check_steps + 1) * scene.check_steps)
                 target = max(target, self.step + 1)
                 t0 = wallclock.perf_counter()
                 emits = (target >= total or target >= step_at(next_arch)
                          or target >= step_at(next_glob))
                 self.advance(target - self.step, flush=emits)
-                if growing and self.step % scene.check_steps == 0:
+                if growing and (self.tip_check_due if watched
+                                else self.step % scene.check_steps == 0):
                     grown = timed("propagation", periodic_task("propagation"), self)
                     if grown:
                         for o in outputs:
@@ -377,6 +391,7 @@ class Simulation:
             status = {"exit_status": "write_failed", "message": str(exc)}
             raise
         finally:
+            self.watch_growth = False
             status["wall_seconds"] = wallclock.perf_counter() - t_wall
             status["steps"] = self.step
             if self.profiler is not None and self.profiler.wall0 is not None:

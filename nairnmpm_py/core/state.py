@@ -28,6 +28,9 @@ STATUS_LEFT_GRID = 2
 STATUS_RUNAWAY = 3
 STATUS_CRACK_LEFT_GRID = 4
 STATUS_CRACK_LISTS_FULL = 5
+# not an error: a watched crack tip may grow, Python's full propagation check is due
+# (``cracks.growth_watch``); the step that set it is complete
+STATUS_TIP_CHECK = -1
 
 # ``S.clock``: time (ms) at the start of the next step, and the USAVG+ / USL+ stress
 # half carried into the next stress pass (ms of update still owed)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 CORE = "nairnmpm_py.core.step_kernels"
 CRACKS = "nairnmpm_py.cracks.crack_kernels"
+WATCH = "nairnmpm_py.cracks.growth_watch"
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,8 @@ STEP = (
     Task("contact_momenta", CRACKS, "frictionless contact on the extrapolated momenta", cracks=True),
     Task("momentum_conditions", CORE, "velocity conditions on the momenta, symmetry planes"),
     Task("check_status", CORE, "NaN, runaway or too many particles leaving", stops=True),
+    Task("watch_growth", WATCH, "at a check: edge maxima; stop for Python's check when J nears "
+         "a tip's threshold", cracks=True, stops=True),
 )
 
 # after the last step of a call that is followed by output, and when a run stops
@@ -89,7 +92,7 @@ class Periodic:
 # the run loop calls (with the simulation), or for the archive the outputs' hook
 PERIODIC = (
     Periodic("propagation", "nairnmpm_py.cracks.scene:propagate",
-             "every check interval (CFL time of a cell)",
+             "when the step's watch stops it, else every check interval (CFL time of a cell)",
              "J at the growing tips and each tip's criterion; grow the cracks", cracks=True),
     Periodic("global_archive", "nairnmpm_py.outputs.global_row:global_row", "GlobalArchive time",
              "energies, loads, displacements and moments: the row every output gets"),
@@ -188,7 +191,9 @@ def driver_source(with_cracks: bool) -> str:
         lines += ["    for step in range(nsteps if S.status[0] == 0 else 0):",
                   "        done = step + 1"]
         lines += _calls(step, "        ", profile, index, "break")
-        lines += ["    if S.status[0] != 0 or flush:"]
+        # a watched tip's stop is not the end of the run: the carried stress half
+        # stays carried, as at any step that is not followed by output
+        lines += ["    if S.status[0] > 0 or (flush and done == nsteps):"]
         lines += _calls(finish, "        ", profile, index, "")
         lines += ["    return done"]
     return "\n".join(lines) + "\n"

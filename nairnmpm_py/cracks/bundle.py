@@ -21,6 +21,8 @@ CrackArrays = namedtuple("CrackArrays", [
     "nlist",                           # (3,) chords, crack nodes, old crack nodes in use
     "counts", "chunk_counts",          # counters (C_*) and per-chunk conflicts
     "thickness", "use_position", "cutoff_cells", "ncx", "ncy",
+    "edge_hist", "openings",           # edge maxima and openings at the last J evaluation
+    "watch", "wgeom", "wstep",         # the growth watch (``growth_watch``)
 ])
 
 # grid rows a crack scene adds to each velocity field, after the core's five: the

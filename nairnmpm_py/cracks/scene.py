@@ -22,44 +22,22 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from ..plugins import registry
 from .bundle import NR, CrackArrays
 from .geometry import EXTERIOR_END, CrackSet
+from .growth_watch import raise_edge_maxima
 from .jintegral import (N_PER_MM_TO_J_PER_M2, NodalFields, StepAssignment, j_integral,
                         step_nodal_fields, stress_intensity, tip_cod, to_mpa_sqrt_m)
 
 INTACT, ACTIVE, FAILED = 0, 1, 2   # crack-particle traction state (kernel ``cstate``)
 NO_MODE = -1.0
-WINDOW_REFRESH = 10   # J checks between refreshes of the particles near a J window
+WINDOW_REFRESH = 10   # steps between refreshes of the particles near a J window
+UNLOAD_SAMPLES = 2000   # openings per law at which the growth watch's W_B >= 0 is tested
 BUILTIN = "nairnmpm_py."   # envelope functions of the package's own traction laws
 # the cracks.csv columns a lean propagation check computes (``_tip_row(lean=True)``)
 J_COLUMNS = {"J_contour_J_m2", "J_tip_J_m2", "J_ff_J_m2", "W_B_crossing_J_m2",
              "W_B_root_J_m2", "W_B_rec_root_J_m2"}
-
-
-@njit(cache=True)
-def _raise_edge_maxima(plane, above, below, crack, first, count, edge_hist, dn):
-    """dn[k]: the normal opening of particle k now; edge_hist[0, k] / [1, k]: the largest
-    mean normal opening of particle k and its previous / next neighbour so far (the
-    particle itself at a crack's ends).  The normal is that of ``CrackScene.cod_at``:
-    across the chord of the neighbours."""
-    n = plane.shape[1]
-    for k in range(n):
-        c = crack[k]
-        kp = max(k - 1, first[c])
-        kn = min(k + 1, first[c] + count[c] - 1)
-        tx = plane[0, kn] - plane[0, kp]
-        ty = plane[1, kn] - plane[1, kp]
-        t = math.hypot(tx, ty)
-        dn[k] = (-ty * (above[0, k] - below[0, k]) + tx * (above[1, k] - below[1, k])) / t
-    for k in range(n):
-        c = crack[k]
-        prev_edge = 0.5 * (dn[k] + dn[max(k - 1, first[c])])
-        next_edge = 0.5 * (dn[k] + dn[min(k + 1, first[c] + count[c] - 1)])
-        edge_hist[0, k] = max(edge_hist[0, k], prev_edge)
-        edge_hist[1, k] = max(edge_hist[1, k], next_edge)
 
 
 @dataclass
@@ -82,6 +60,9 @@ class CrackScene:
     contact_position: float | None = None   # ContactPosition (cells) or None
     jcontour_sizes: list = field(default_factory=list)   # extra sizes for jcontours.csv
     propagate_length: float = 0.5                        # cells per growth step
+    # the step watches the growing tips (``growth_watch``); False runs Python's full
+    # check at every interval (the same results, slower: for comparisons)
+    watch_tips: bool = True
 
     def __post_init__(self):
         cs = self.cracks
@@ -93,14 +74,17 @@ class CrackScene:
         self.edge_hist = np.zeros((2, nc))
         self.openings = np.zeros(nc)      # normal openings at the last J evaluation
         self.pid = np.arange(nc)          # identity of each crack particle (kept on growth)
+        self._kernel_arrays()
         self.counts = np.zeros(4, dtype=np.int64)
         self.initial_tips = {(t.crack, t.end): self._tip_point(t).copy() for t in self.tips}
         self.initial_root = {(t.crack, t.end): int(self.pid[self.zone(t)[1]]) for t in self.tips}
         self.check_steps = 1
         self.growth_log: list[dict] = []
+        self.full_checks = 0              # Python's full propagation checks so far
         self._subset = np.zeros(0, dtype=np.int64)   # particles near the J window
         self._subset_window = None
-        self._subset_age = 0
+        self._subset_step = 0
+        self._unload_ok = None
 
     # ---- kernel side ---------------------------------------------------------------
     n_rows = NR                      # grid rows per field: the core's and the contact rows
@@ -150,6 +134,9 @@ class CrackScene:
         self.cnodes = np.zeros(nn, dtype=np.int64)             # crack lists (see bundle)
         self.cnodes_old = np.zeros(nn, dtype=np.int64)
         self.nlist = np.zeros(3, dtype=np.int64)
+        g = sim.grid
+        self.wgeom = np.array([g.xmin, g.ymin, g.dx, g.dy, g.nx, g.ny], dtype=float)
+        self.wstep = np.zeros(2, dtype=np.int64)
         self._chord_capacity()
         self._kernel_arrays()
         if self.growing:
@@ -196,7 +183,55 @@ class CrackScene:
             self.vfld, self.cut, self.nslot, self.cstart, self.cnear, self.cbox, self.chords,
             self.cxy, self.cnodes, self.cnodes_old, self.nlist, self.counts, self.chunk_counts,
             float(grid.thickness), self.contact_position is not None,
-            float(self.contact_position or 0.0), grid.nodes_x - 1, grid.nodes_y - 1)
+            float(self.contact_position or 0.0), grid.nodes_x - 1, grid.nodes_y - 1,
+            self.edge_hist, self._openings(), self.watch_table(sim), self.wgeom,
+            self._watch_steps(sim))
+
+    def _openings(self) -> np.ndarray:
+        if self.openings.size != self.cracks.plane.shape[1]:
+            self.openings = np.zeros(self.cracks.plane.shape[1])
+        return self.openings
+
+    def _watch_steps(self, sim) -> np.ndarray:
+        self.wstep[0] = sim.step
+        self.wstep[1] = self.check_steps
+        return self.wstep
+
+    def watch_table(self, sim) -> np.ndarray:
+        """The tips the step watches (``growth_watch``: crack, end, threshold in N/mm,
+        contour size), while ``sim.watch_growth`` (a run) asks for it.  None when a
+        growing tip's criterion has no J_tip threshold or a law could make W_B
+        negative: Python's full check then runs at every interval."""
+        tips = [t for t in self.tips if t.criterion is not None and not t.stopped]
+        none = np.zeros((0, 4))
+        if (not self.watch_tips or not getattr(sim, "watch_growth", False) or not tips
+                or not self._laws_unload_safely()):
+            return none
+        rows = []
+        for t in tips:
+            threshold = t.criterion.growth_threshold(sim.materials[t.material])
+            if threshold is None or math.isnan(threshold):
+                return none
+            rows.append((t.crack, 1.0 if t.end == "end" else 0.0,
+                         threshold / N_PER_MM_TO_J_PER_M2, self.jcontour_size))
+        return np.array(rows, dtype=float)
+
+    def _laws_unload_safely(self) -> bool:
+        """W_B >= 0 at every opening, which the growth watch's bound needs: each law's
+        envelope is non-negative and its dissipated energy (loading work less the
+        linear unloading's return) is too, tested at ``UNLOAD_SAMPLES`` openings up to
+        delta_c and at its kinks."""
+        if self._unload_ok is None:
+            ok = True
+            for law in self.laws.values():
+                env = law.mode(1)
+                h = np.union1d(np.linspace(0.0, law.delta_c(1), UNLOAD_SAMPLES + 1)[1:],
+                               [p for p in env.breakpoints if 0.0 < p < law.delta_c(1)])
+                tol = 1e-9 * abs(law.area(1))
+                ok = ok and bool(np.all(law.envelope(h, 1) >= 0.0)
+                                 and np.all(law.dissipated(h, 1) >= -tol))
+            self._unload_ok = ok
+        return self._unload_ok
 
     # ---- zone and traction work -------------------------------------------------------
     def _tip_point(self, tip: Tip) -> np.ndarray:
@@ -280,10 +315,8 @@ class CrackScene:
         every J evaluation: every propagation check while tips grow, else every
         archive)."""
         cs = self.cracks
-        self.openings = np.empty(cs.plane.shape[1])
-        _raise_edge_maxima(cs.plane, cs.above, cs.below, cs.crack.astype(np.int64),
-                           cs.first.astype(np.int64), cs.count.astype(np.int64), self.edge_hist,
-                           self.openings)
+        raise_edge_maxima(cs.plane, cs.above, cs.below, self.ccrack, self.cfirst, self.clast,
+                          self.edge_hist, self._openings())
 
     def cod_at(self, k: int) -> tuple[float, float]:
         """(normal, tangential) opening (mm) at crack particle k."""
@@ -342,11 +375,10 @@ class CrackScene:
 
     def _window_particles(self, sim, window) -> np.ndarray:
         """Particles that may reach the nodes of ``window``: found again when the window
-        changes or every ``WINDOW_REFRESH`` checks, with a margin of a cell more than
+        changes or every ``WINDOW_REFRESH`` steps, with a margin of a cell more than
         a particle can reach, which no particle crosses in that many steps (a CFL
         step moves a particle well under a tenth of a cell)."""
-        self._subset_age += 1
-        if self._subset_window != window or self._subset_age > WINDOW_REFRESH:
+        if self._subset_window != window or sim.step - self._subset_step > WINDOW_REFRESH:
             g, p = sim.grid, sim.particles
             i0, i1, j0, j1 = window
             reach = 2.5      # cells: uGIMP reach (1.5) plus a cell of margin
@@ -355,7 +387,7 @@ class CrackScene:
                     & (y >= g.ymin + (j0 - reach) * g.dy) & (y <= g.ymin + (j1 + reach) * g.dy))
             self._subset = np.flatnonzero(keep).astype(np.int64)
             self._subset_window = window
-            self._subset_age = 0
+            self._subset_step = sim.step
         return self._subset
 
     def _tip_row(self, sim, fields, tip: Tip, size: int, lean: bool = False) -> dict:
@@ -433,6 +465,7 @@ class CrackScene:
         tips = [t for t in self.tips if t.criterion is not None and not t.stopped]
         if not tips:
             return []
+        self.full_checks += 1
         # a check runs every step or so: with criteria that read J columns only, the
         # rest of a row is computed for a tip that grows only
         lean = all(t.criterion.row_keys is not None and set(t.criterion.row_keys) <= J_COLUMNS
@@ -526,6 +559,7 @@ class CrackScene:
                                  for t in self.tips if t.stopped},
                 "failed_traction_particles": int(np.sum(self.state == FAILED)),
                 "propagation_check_steps": int(self.check_steps),
+                "propagation_full_checks": int(self.full_checks),
                 "field_conflicts": int(self.counts[0]),
                 "surfaces_without_material": int(self.counts[1]),
                 "blocked_crack_moves": int(self.counts[3])}

@@ -10,6 +10,9 @@ fracture properties (``JIc``, ``JIIc`` in J/m^2, ``KIc``, ``KIIc`` in MPa sqrt(m
 (``J_contour_J_m2``, ``J_tip_J_m2``, ``J_ff_J_m2``, ``W_B_*``): a check then skips
 the rest of the row (K, the notch CODs), which it computes only for a tip that grows.
 None (the default) gives every check the whole row.
+``growth_threshold(material)`` is a J_tip (J/m^2) below which ``should_grow`` is never
+true, or None (the default): with one, the time step watches the tip itself and
+Python's full check runs only when J nears it (``cracks.growth_watch``).
 
 The framework owns the rest (NairnMPM's rules, shared notes JINTEGRAL.md section 8):
 when to check, the growth direction and length, the new crack particle and the
@@ -27,6 +30,10 @@ class PropagationCriterion:
 
     def should_grow(self, tip: dict, material) -> bool:  # pragma: no cover - abstract
         raise NotImplementedError
+
+    def growth_threshold(self, material) -> float | None:
+        """J_tip (J/m^2) below which this criterion never grows the tip, or None."""
+        return None
 
     def critical_J(self, material) -> float:
         """J_tip,c in J/m^2 (NaN when the criterion has none)."""

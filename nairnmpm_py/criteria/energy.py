@@ -17,6 +17,9 @@ class CriticalEnergyRelease(PropagationCriterion):
         v = getattr(material.params, "JIc", None)
         return float(v) if v is not None else math.nan
 
+    def growth_threshold(self, material) -> float:
+        return self.critical_J(material)
+
     def check(self, material):
         if getattr(material.params, "JIc", None) is None:
             return (f"propagation criterion 7 needs <JIc> (J/m^2) in the crack-tip "
@@ -33,6 +36,9 @@ class NoPropagation(PropagationCriterion):
     name = "None"
     nairn_type = 0
     row_keys = ()
+
+    def growth_threshold(self, material) -> float:
+        return math.inf
 
     def should_grow(self, tip: dict, material) -> bool:
         return False
