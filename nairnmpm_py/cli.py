@@ -1,6 +1,7 @@
 """The ``nairnmpm`` command: a thin layer over the package's functions.
 
-Exit codes: 0 done, 2 bad input, 3 the simulation went unstable, 130 interrupted.
+Exit codes: 0 done, 2 bad input, 3 the simulation went unstable, 130 interrupted
+(after a checkpoint: ``nairnmpm resume DIR`` goes on).
 """
 from __future__ import annotations
 
@@ -81,7 +82,7 @@ def cmd_check(args) -> int:
 
 
 def cmd_run(args) -> int:
-    from .errors import InputError, SimulationUnstable
+    from .errors import InputError
     from .input import load_simulation
     from .outputs.defaults import default_outputs
     path = Path(args.file)
@@ -105,12 +106,62 @@ def cmd_run(args) -> int:
     except OSError as exc:
         print(f"{out}: cannot create the results folder: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_INPUT
-    outputs = default_outputs(out)
+    return _execute(sim, path, out, default_outputs(out), args, resumed=False)
+
+
+def cmd_resume(args) -> int:
+    from .errors import InputError
+    from .outputs.defaults import default_outputs
+    from .resume import ResumeError, load_resumable
+    folder = Path(args.dir)
+    try:
+        sim, ck = load_resumable(folder, args.max_time, args.force)
+    except ResumeError as exc:
+        print(exc, file=sys.stderr)
+        return EXIT_INPUT
+    except InputError as exc:
+        _print_problems(exc)
+        return EXIT_INPUT
+    if sim.step >= sim.n_steps:
+        print(f"{folder}: the run is done at {ck.time_ms:.6g} ms (MaxTime); give --max-time to "
+              "go further", file=sys.stderr)
+        return EXIT_INPUT
+    outputs = default_outputs(folder)
+    try:
+        for o in outputs:
+            o.resume(sim, ck.step, ck.time_ms)
+    except OSError as exc:
+        print(f"{exc.filename or folder}: cannot continue the results: {exc.strerror or exc}",
+              file=sys.stderr)
+        return EXIT_INPUT
+    if not args.quiet:
+        print(f"resuming {folder} at step {ck.step} ({ck.time_ms:.6g} ms) to "
+              f"{sim.max_time:g} ms", file=sys.stderr)
+    return _execute(sim, Path(sim.source.get("path") or folder), folder, outputs, args,
+                    resumed=True)
+
+
+def _stop_on_signal(sim):
+    """SIGINT / SIGTERM: the first asks the run to stop at its next return to Python
+    (a fraction of a second) after writing a checkpoint; a second stops it at once."""
+    def handler(signum, frame):
+        if sim.stop_requested:
+            raise KeyboardInterrupt
+        sim.request_stop()
+    return handler
+
+
+def _execute(sim, path: Path, out: Path, outputs: list, args, resumed: bool) -> int:
+    """Run (or go on with) ``sim`` into ``out`` with a progress bar, checkpoints and
+    signal handling; the exit code."""
+    from .core.checkpoint import Checkpoints
+    from .errors import SimulationUnstable
     show = not args.quiet and sys.stderr.isatty()
     bar = None
     if show:
         from tqdm import tqdm
-        bar = tqdm(total=sim.n_steps, unit="step", dynamic_ncols=True, file=sys.stderr,
+        bar = tqdm(total=sim.n_steps, initial=sim.step, unit="step", dynamic_ncols=True,
+                   file=sys.stderr,
                    bar_format="{l_bar}{bar}| {n_fmt}/{total_fmt} steps [{elapsed}<{remaining}, "
                               "{rate_fmt}]{postfix}")
 
@@ -119,13 +170,15 @@ def cmd_run(args) -> int:
             bar.n = step
             bar.set_postfix_str(f"t = {time_ms:.4g} ms", refresh=False)
             bar.refresh()
-    if not args.quiet:
+    if not args.quiet and not resumed:
         print(_summary(sim), file=sys.stderr)
-    # a job scheduler's SIGTERM stops the run as Ctrl-C does: at the next return to
-    # Python (a fraction of a second), with every output closed and exit 130
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    checkpoints = Checkpoints(out, args.checkpoint_every)
+    # Ctrl-C and a job scheduler's SIGTERM: a checkpoint, every output closed, exit 130
+    handler = _stop_on_signal(sim)
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        status = sim.run(outputs, progress=progress, profile=args.profile)
+        status = sim.run(outputs, progress=progress, profile=args.profile,
+                         checkpoints=checkpoints, resumed=resumed)
     except SimulationUnstable as exc:
         if bar is not None:
             bar.close()
@@ -134,7 +187,9 @@ def cmd_run(args) -> int:
     except KeyboardInterrupt:
         if bar is not None:
             bar.close()
-        print(f"\ninterrupted; results so far are in {out}", file=sys.stderr)
+        where = (f"; continue with: nairnmpm resume {out}" if checkpoints.written else "")
+        print(f"\ninterrupted at step {sim.step}; results so far are in {out}{where}",
+              file=sys.stderr)
         return EXIT_INTERRUPTED
     except OSError as exc:      # a full disk, a folder made unwritable during the run
         if bar is not None:
@@ -143,7 +198,8 @@ def cmd_run(args) -> int:
               f"what was written before is in {out}", file=sys.stderr)
         return EXIT_INPUT
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, old in previous.items():
+            signal.signal(sig, old)
     if bar is not None:
         bar.close()
     if not args.quiet:
@@ -203,7 +259,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-q", "--quiet", action="store_true", help="no summary or progress bar")
     p.add_argument("--profile", action="store_true",
                    help="time each task of the step; table at the end and in run.json")
+    p.add_argument("--checkpoint-every", type=float, metavar="MINUTES",
+                   help="also write a checkpoint every MINUTES of wall time (one is "
+                        "written after each archive and when the run is interrupted)")
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("resume", help="continue a run from its last checkpoint")
+    p.add_argument("dir", help="the run's results folder")
+    p.add_argument("--max-time", type=float, metavar="MS",
+                   help="run to this time (ms) instead of the input's MaxTime")
+    p.add_argument("--force", action="store_true",
+                   help="resume even though the input file changed since the run started")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--profile", action="store_true",
+                   help="per-task timing table of this part (run.json and printed)")
+    p.add_argument("--checkpoint-every", type=float, metavar="MINUTES",
+                   help="also write a checkpoint every MINUTES of wall time")
+    p.set_defaults(func=cmd_resume)
     p = sub.add_parser("check", help="parse and validate only; print a summary")
     p.add_argument("file")
     p.set_defaults(func=cmd_check)

@@ -1,5 +1,6 @@
-"""A run stopped by Ctrl-C (SIGINT) or a job scheduler (SIGTERM): exit 130, every
-output closed and readable, the exit status recorded as interrupted."""
+"""A run stopped by Ctrl-C (SIGINT) or a job scheduler (SIGTERM): a checkpoint, exit
+130, every output closed and readable, the exit status recorded as interrupted, and
+``nairnmpm resume`` goes on from where it stopped."""
 from __future__ import annotations
 
 import json
@@ -72,3 +73,13 @@ def test_a_signal_stops_the_run_with_exit_130_and_readable_results(tmp_path, sig
         assert len(h5["archives"]) >= 1
     lines = rows.read_text().splitlines()
     assert len(lines) > 5 and all(line.count(",") == lines[0].count(",") for line in lines)
+    # the checkpoint is the state it stopped in: resume goes on from there
+    assert run["checkpoint_step"] == run["steps_taken"]
+    more = run["time_reached_ms"] + 0.05
+    done = subprocess.run([sys.executable, "-m", "nairnmpm_py.cli", "resume", str(out), "-q",
+                           "--max-time", repr(more)], capture_output=True, text=True,
+                          timeout=STARTUP_S)
+    assert done.returncode == 0, done.stderr
+    steps = [int(line.split(",")[1]) for line in rows.read_text().splitlines()[1:]]
+    assert steps == sorted(set(steps)) and steps[-1] > run["steps_taken"]
+    assert json.loads((out / "run.json").read_text())["exit_status"] == "done"

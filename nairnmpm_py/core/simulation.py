@@ -85,6 +85,8 @@ class Simulation:
         # driver then stops only when a tip may grow (``tip_check_due``)
         self.watch_growth = False
         self.tip_check_due = False
+        self.stop_requested = False
+        self.wall_before = 0.0     # wall seconds of the parts of a resumed run before this
         self.couples = None    # particle-load groups with a moment column (global row)
         self.rec_force = np.zeros(len(self.conditions.records))
         self.rec_work = np.zeros(len(self.conditions.records))
@@ -304,7 +306,7 @@ class Simulation:
 
     def run(self, outputs: list | None = None,
             progress: Callable[[float, float, int, float], None] | None = None,
-            profile: bool = False) -> dict:
+            profile: bool = False, checkpoints=None, resumed: bool = False) -> dict:
         """Run to ``max_time``.  ``progress(fraction, time_ms, step, steps_per_s)``.
 
         Output plugins get ``begin(sim)``, ``on_global(sim, row)``,
@@ -312,11 +314,19 @@ class Simulation:
         when the run blows up or is interrupted, so what they wrote stays readable.
         With ``profile`` the returned status (and run.json) gets ``"profile"``: each
         task's time per step and share of the run (``core/profile``).
+        ``checkpoints`` (``core.checkpoint.Checkpoints``) writes a checkpoint after
+        each archive, at its wall-time interval and when ``request_stop`` was
+        called (then the run raises KeyboardInterrupt).  ``resumed``: the state was
+        restored from a checkpoint (``core.checkpoint.restore``) and the outputs were
+        given ``resume``: the run goes on from there without a first extrapolation
+        or first archive.
         """
         outputs = outputs or []
         t_wall = wallclock.perf_counter()
+        wall_before = self.wall_before if resumed else 0.0
         self.prepare()
-        self.grid_current = False   # the particles may have been changed since
+        if not resumed:
+            self.grid_current = False   # the particles may have been changed since
         self.profiler = StepProfile(self.cracks is not None) if profile else None
         self.advance(0, flush=False)   # compiles the driver; extrapolates the start
         if self.profiler is not None:
@@ -333,11 +343,21 @@ class Simulation:
         glob_dt = self.global_archive_time or arch_dt
         next_arch = max(self.archive_start, arch_dt) if self.archive_start > 0 else arch_dt
         next_glob = glob_dt
+        # a resumed run's next output times, summed as the first part summed them
+        while self.step >= step_at(next_arch):
+            next_arch += arch_dt
+        while self.step >= step_at(next_glob):
+            next_glob += glob_dt
         status = {"exit_status": "running"}
-        for o in outputs:
-            o.begin(self)
+        if not resumed:
+            for o in outputs:
+                o.begin(self)
+
+        def wall_so_far() -> float:
+            return wall_before + wallclock.perf_counter() - t_wall
         try:
-            self._emit(outputs, archive=True, glob=True)
+            if not resumed:
+                self._emit(outputs, archive=True, glob=True)
             chunk = 20
             start_run = wallclock.perf_counter()
             step0 = self.step
@@ -348,6 +368,12 @@ class Simulation:
             growing = scene is not None and scene.growing
             self.watch_growth = growing
             while self.step < total:
+                if self.stop_requested:
+                    # between driver calls, after the last call's outputs: the state
+                    # and the files agree, so the checkpoint resumes exactly
+                    if checkpoints is not None:
+                        checkpoints.write(self, wall_so_far())
+                    raise KeyboardInterrupt
                 target = min(step_at(next_arch), step_at(next_glob), total, self.step + chunk)
                 # without a watch on every growing tip, stop at every propagation check
                 watched = growing and scene.watch_table(self).shape[0] > 0
@@ -377,6 +403,8 @@ class Simulation:
                 while self.step >= step_at(next_glob):
                     next_glob += glob_dt
                 self._emit(outputs, archive=archive, glob=glob, timed=timed)
+                if checkpoints is not None and checkpoints.due(archive):
+                    timed("checkpoint", checkpoints.write, self, wall_so_far())
                 if progress is not None:
                     el = wallclock.perf_counter() - start_run
                     progress(self.step / total, self.time, self.step, self.step / max(el, 1e-9))
@@ -386,20 +414,31 @@ class Simulation:
             raise
         except KeyboardInterrupt:
             status = {"exit_status": "interrupted"}
+            if checkpoints is not None and checkpoints.written:
+                status["checkpoint_step"] = checkpoints.last_step
             raise
         except OSError as exc:
             status = {"exit_status": "write_failed", "message": str(exc)}
             raise
         finally:
             self.watch_growth = False
-            status["wall_seconds"] = wallclock.perf_counter() - t_wall
+            self.stop_requested = False
+            status["wall_seconds"] = wall_so_far()
             status["steps"] = self.step
+            if checkpoints is not None:
+                status["checkpoints"] = {"written": checkpoints.written,
+                                         "seconds": checkpoints.seconds}
             if self.profiler is not None and self.profiler.wall0 is not None:
                 self.profiler.stop()
                 status["profile"] = self.profiler.rows(self.step - step0)
             self.profiler = None
             self._end_outputs(outputs, status)
         return status
+
+    def request_stop(self) -> None:
+        """Stop the run at its next return to Python (a fraction of a second), after
+        writing a checkpoint if it keeps them (a signal handler may call this)."""
+        self.stop_requested = True
 
     def _end_outputs(self, outputs, status: dict) -> None:
         """Close every output, also when one of them cannot write (a full disk): the

@@ -98,6 +98,9 @@ PERIODIC = (
              "energies, loads, displacements and moments: the row every output gets"),
     Periodic("archive", "outputs' on_archive", "ArchiveTime",
              "J and K at every tip (cracks.csv), HDF5 and VTU archives"),
+    Periodic("checkpoint", "nairnmpm_py.core.checkpoint:write_checkpoint",
+             "after each archive, every --checkpoint-every minutes, on SIGINT / SIGTERM",
+             "the whole state, for nairnmpm resume"),
 )
 
 

@@ -92,6 +92,19 @@ class ArchiveH5(OutputPlugin):
         # after a flush the file on disk is consistent, so a killed run stays readable
         self._h5.flush()
 
+    def resume(self, sim, step: int, time_ms: float) -> None:
+        """Archives after the checkpoint's step (a run that went on past it) are
+        dropped; new ones are added to the same file."""
+        if not self.path.exists():
+            self.begin(sim)
+            return
+        h5 = self._h5 = h5py.File(self.path, "a")
+        archives = h5.require_group("archives")
+        for key in [k for k in archives if int(k) > step]:
+            del archives[key]
+        h5.attrs["exit_status"] = "running"
+        h5.flush()
+
     def end(self, sim, status: dict) -> None:
         if self._h5 is None:
             if not self.path.exists():

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .base import OutputPlugin
+from .base import OutputPlugin, keep_csv_rows
 
 COLUMNS = ["time_ms", "crack", "tip", "contour_cells", "tip_x_mm", "tip_y_mm",
            "crack_growth_mm", "root_x_mm", "root_y_mm", "zone_length_mm", "J_contour_J_m2",
@@ -33,9 +33,10 @@ def _cell(v) -> str:
 
 
 class _CsvFile:
-    def __init__(self, path: Path):
-        self.file = open(path, "w", newline="\n")
-        self.file.write(",".join(COLUMNS) + "\n")
+    def __init__(self, path: Path, append: bool = False):
+        self.file = open(path, "a" if append else "w", newline="\n")
+        if not append:
+            self.file.write(",".join(COLUMNS) + "\n")
 
     def write(self, rows: list[dict]) -> None:
         for r in rows:
@@ -76,6 +77,23 @@ class CracksCsv(OutputPlugin):
         that made them grow."""
         if self._tips is not None:
             self._tips.write(rows)
+
+    def resume(self, sim, step: int, time_ms: float) -> None:
+        """Rows up to the checkpoint's time stay (the next step's are dt later)."""
+        scene = getattr(sim, "cracks", None)
+        if scene is None or not scene.tips:
+            return
+        late = time_ms + 0.5 * sim.dt
+        names = [self.filename] + (["jcontours.csv"] if scene.jcontour_sizes else [])
+        files = []
+        for name in names:
+            path = self.folder / name
+            if keep_csv_rows(path, lambda cells: float(cells[0]) <= late) == COLUMNS:
+                files.append(_CsvFile(path, append=True))
+            else:
+                files.append(_CsvFile(path))
+        self._tips = files[0]
+        self._contours = files[1] if len(files) > 1 else None
 
     def end(self, sim, status: dict) -> None:
         for f in (self._tips, self._contours):

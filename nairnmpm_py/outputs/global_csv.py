@@ -4,7 +4,7 @@ from __future__ import annotations
 from numbers import Integral
 from pathlib import Path
 
-from .base import OutputPlugin
+from .base import OutputPlugin, keep_csv_rows
 
 
 def _format(value) -> str:
@@ -33,9 +33,29 @@ class GlobalCsv(OutputPlugin):
         if self._columns is None:
             self._columns = list(row)
             self._file.write(",".join(self._columns) + "\n")
-        self._file.write(",".join(_format(row[c]) for c in self._columns) + "\n")
+        # a run resumed with --force from a changed input may lack a column: empty
+        self._file.write(",".join(_format(row[c]) if c in row else "" for c in self._columns)
+                         + "\n")
         # flushed per row so a crash or kill leaves every finished row on disk
         self._file.flush()
+
+    def resume(self, sim, step: int, time_ms: float) -> None:
+        path = self.folder / self.filename
+        at = {}
+
+        def keep(cells):
+            return int(cells[at["step"]]) <= step
+        header = []
+        if path.exists():
+            first = path.read_text().split("\n", 1)[0].split(",")
+            if "step" in first:
+                at["step"] = first.index("step")
+                header = keep_csv_rows(path, keep)
+        if not header:
+            self.begin(sim)
+            return
+        self._file = open(path, "a", newline="\n")
+        self._columns = header
 
     def end(self, sim, status: dict) -> None:
         if self._file is not None:

@@ -61,6 +61,24 @@ class RunJson(OutputPlugin):
                 self.info["r_curve_theory"] = theory
         self._write(sim)
 
+    def resume(self, sim, step: int, time_ms: float) -> None:
+        """The first part's record, with the resume added; the wall seconds at the end
+        are those of all parts."""
+        path = self.folder / self.filename
+        try:
+            self.info = json.loads(path.read_text())
+        except (OSError, ValueError):
+            self.begin(sim)
+            return
+        self.info.setdefault("resumes", []).append(
+            {"from_step": int(step), "from_time_ms": float(time_ms),
+             "wall_seconds_before": float(getattr(sim, "wall_before", 0.0)),
+             "max_time_ms": float(sim.max_time)})
+        self.info["max_time_ms"] = float(sim.max_time)
+        self.info["steps_planned"] = int(sim.n_steps)
+        self.info["exit_status"] = "running"
+        self._write(sim)
+
     def end(self, sim, status: dict) -> None:
         if not self.info:
             self.begin(sim)
@@ -72,6 +90,10 @@ class RunJson(OutputPlugin):
             self.info["message"] = str(status["message"])
         if status.get("profile"):
             self.info["profile"] = status["profile"]
+        if status.get("checkpoints"):
+            self.info["checkpoints"] = status["checkpoints"]
+        if "checkpoint_step" in status:
+            self.info["checkpoint_step"] = status["checkpoint_step"]
         scene = getattr(sim, "cracks", None)
         if scene is not None:
             self.info["cracks"] = scene.summary()

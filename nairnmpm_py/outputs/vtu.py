@@ -3,6 +3,7 @@ and, in scenes with cracks, the crack polylines (``cracks.pvd``)."""
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -23,6 +24,18 @@ def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text("\n".join(lines))
     os.replace(tmp, path)
+
+
+def read_pvd(path: Path) -> list[tuple[float, str]]:
+    """The (time, file) entries of a collection ``write_pvd`` wrote ([] if none)."""
+    if not path.exists():
+        return []
+    return [(float(t), f) for t, f in
+            re.findall(r'<DataSet timestep="([^"]+)" part="0" file="([^"]+)"/>', path.read_text())]
+
+
+def _step_of(rel: str) -> int:
+    return int(re.search(r"_(\d+)\.vtu$", rel).group(1))
 
 
 def particle_mesh(particles) -> meshio.Mesh:
@@ -101,3 +114,18 @@ class VtuSeries(OutputPlugin):
             self.crack_entries = ([e for e in self.crack_entries if e[1] != rel]
                                   + [(float(sim.time), rel)])
             write_pvd(self.folder / "cracks.pvd", self.crack_entries)
+
+    def resume(self, sim, step: int, time_ms: float) -> None:
+        """The collections keep the files up to the checkpoint's step; later ones (a
+        run that went on past it) are removed and written again."""
+        (self.folder / "vtu").mkdir(exist_ok=True)
+        for attr, name in (("entries", "particles.pvd"), ("crack_entries", "cracks.pvd")):
+            kept = []
+            for t, rel in read_pvd(self.folder / name):
+                if _step_of(rel) <= step:
+                    kept.append((t, rel))
+                else:
+                    (self.folder / rel).unlink(missing_ok=True)
+            setattr(self, attr, kept)
+            if (self.folder / name).exists():
+                write_pvd(self.folder / name, kept)
