@@ -47,7 +47,7 @@ def _last_archive(folder: Path) -> tuple[str, dict]:
         return keys, arrays
 
 
-def _assert_same_results(ref: Path, resumed: Path) -> None:
+def _assert_same_results(ref: Path, resumed: Path, resumes: int | None = 1) -> None:
     for name in TEXT_FILES:
         if (ref / name).exists():
             assert (resumed / name).read_text() == (ref / name).read_text(), name
@@ -60,7 +60,8 @@ def _assert_same_results(ref: Path, resumed: Path) -> None:
     info = json.loads((resumed / "run.json").read_text())
     assert info["exit_status"] == "done"
     assert info["steps_taken"] == json.loads((ref / "run.json").read_text())["steps_taken"]
-    assert len(info["resumes"]) == 1
+    if resumes is not None:
+        assert len(info["resumes"]) == resumes
 
 
 def test_a_plain_run_resumed_equals_one_never_stopped(tmp_path):
@@ -120,3 +121,39 @@ def test_resume_refuses_a_changed_input_and_a_folder_without_checkpoint(tmp_path
     empty.mkdir()
     assert main(["resume", str(empty), "-q"]) == 2
     assert "no checkpoint" in capsys.readouterr().err
+
+
+def test_runs_killed_at_random_moments_resume_to_the_same_results(tmp_path):
+    """SIGKILL gives no chance to clean up: whatever checkpoint and archives it leaves
+    must be whole, and resuming from them must end as the run that was never killed."""
+    import random
+    import signal
+    import subprocess
+    import sys
+    import time
+    xml = tmp_path / "ramp.xml"
+    xml.write_text(RAMP.read_text().replace('<MaxTime units="ms">2</MaxTime>',
+                                            '<MaxTime units="ms">8</MaxTime>'))
+    ref = tmp_path / "ref"
+    assert main(["run", str(xml), "-o", str(ref), "-q"]) == 0
+    wall = json.loads((ref / "run.json").read_text())["wall_seconds"]
+    out = tmp_path / "killed"
+    rng = random.Random(14)
+    command = [sys.executable, "-m", "nairnmpm_py.cli", "run", str(xml), "-o", str(out), "-q"]
+    kills = 0
+    for _ in range(3):
+        proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        deadline = time.monotonic() + 300
+        while (proc.poll() is None and not (out / "checkpoint.h5").exists()
+               and time.monotonic() < deadline):
+            time.sleep(0.02)
+        time.sleep(rng.uniform(0.0, 0.6 * wall))
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGKILL)
+            kills += 1
+        proc.wait()
+        command = [sys.executable, "-m", "nairnmpm_py.cli", "resume", str(out), "-q"]
+    assert kills >= 2
+    while json.loads((out / "run.json").read_text())["exit_status"] != "done":
+        assert main(["resume", str(out), "-q"]) == 0
+    _assert_same_results(ref, out, resumes=None)

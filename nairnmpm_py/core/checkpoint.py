@@ -19,13 +19,14 @@ renamed over the previous one: a kill at any moment leaves a whole checkpoint.
 from __future__ import annotations
 
 import json
-import os
 import time as wallclock
 from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+from .durable import aside, replace_durably
 
 FORMAT = 1
 FILENAME = "checkpoint.h5"
@@ -64,7 +65,7 @@ def _python_state(sim) -> dict:
 def write_checkpoint(sim, folder: Path, wall_seconds: float) -> Path:
     """Write ``folder/checkpoint.h5`` for ``sim`` as it stands (between driver calls)."""
     path = Path(folder) / FILENAME
-    tmp = path.with_name(path.name + ".tmp")
+    tmp = aside(path)
     with h5py.File(tmp, "w") as h5:
         h5.attrs["format"] = FORMAT
         h5.attrs["step"] = int(sim.step)
@@ -82,12 +83,7 @@ def write_checkpoint(sim, folder: Path, wall_seconds: float) -> Path:
                 if isinstance(value, np.ndarray) and name not in NOT_STATE.get(owner, ()):
                     grp.create_dataset(name, data=value)
         h5.attrs["state"] = json.dumps(_python_state(sim))
-    fd = os.open(tmp, os.O_RDONLY)
-    try:
-        os.fsync(fd)        # on disk before it replaces the previous checkpoint
-    finally:
-        os.close(fd)
-    os.replace(tmp, path)
+    replace_durably(tmp, path)
     return path
 
 

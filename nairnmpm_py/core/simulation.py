@@ -358,6 +358,8 @@ class Simulation:
         try:
             if not resumed:
                 self._emit(outputs, archive=True, glob=True)
+                if checkpoints is not None:   # a run killed before its next archive resumes
+                    checkpoints.write(self, wall_so_far())
             chunk = 20
             start_run = wallclock.perf_counter()
             step0 = self.step
