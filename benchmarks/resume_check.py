@@ -25,6 +25,7 @@ import argparse
 import json
 import os
 import random
+import shutil
 import signal
 import subprocess
 import sys
@@ -68,7 +69,7 @@ def _start(threads: int, *args: str) -> subprocess.Popen:
 
 def _growth_rows(folder: Path) -> int:
     path = folder / "cracks.csv"
-    return path.read_text().count(",growth,") if path.exists() else 0
+    return path.read_text().count(',"growth",') if path.exists() else 0
 
 
 def _archives(folder: Path) -> tuple[list[str], dict]:
@@ -128,11 +129,14 @@ def check(threads: int, tmax: float, kills: int, seed: int, work: Path) -> list[
 
     # SIGTERM in the middle of the growth
     folder = work / f"sigterm_t{threads}"
+    shutil.rmtree(folder, ignore_errors=True)     # no stale files to wait on
     proc = _start(threads, "run", str(xml), "-o", str(folder), "--force")
     while proc.poll() is None and _growth_rows(folder) < 3:
         time.sleep(0.05)
     proc.send_signal(signal.SIGTERM)
     code = proc.wait()
+    if code != 130:
+        raise RuntimeError(f"the run was not stopped by SIGTERM (exit {code})")
     stopped_at = json.loads((folder / "run.json").read_text())["steps_taken"]
     resumes = _resume_until_done(threads, folder)
     diff = _same(ref, folder)
@@ -143,6 +147,7 @@ def check(threads: int, tmax: float, kills: int, seed: int, work: Path) -> list[
     # SIGKILL at random moments: of the first run, then of the resumes
     rng = random.Random(seed + threads)
     folder = work / f"sigkill_t{threads}"
+    shutil.rmtree(folder, ignore_errors=True)
     proc = _start(threads, "run", str(xml), "-o", str(folder), "--force")
     done_kills = 0
     while done_kills < kills:

@@ -53,7 +53,7 @@ def build_simulation(model: InputModel) -> Simulation:
     cracks = _crack_scene(r, model, materials, names)
     r.check()
     h = model.mpm
-    return Simulation(
+    sim = Simulation(
         grid=grid, particles=particles, materials=materials, conditions=conditions,
         plane_stress=model.analysis == 11, method=h.method,
         post_extrapolate=h.post_extrapolate, leave_limit=h.leave_limit,
@@ -64,18 +64,39 @@ def build_simulation(model: InputModel) -> Simulation:
         damping=h.damping_per_s * PER_S_TO_PER_MS, global_quantities=quantities,
         title=model.title, source={"path": model.path, "sha256": model.sha256, "text": model.text},
         material_names=names, cracks=cracks)
+    _check_steps(r, sim, h.max_time_line)
+    r.check()
+    return sim
+
+
+MAX_STEPS = 10 ** 12   # about 30 years of this machine at a microsecond per step
+
+
+def _check_steps(r: Reader, sim: Simulation, line: int | None) -> None:
+    """A run of more steps than any machine finishes (a MaxTime in the wrong units, or
+    a modulus that makes the time step vanish) is refused before it starts."""
+    steps = sim.max_time / sim.dt if sim.dt > 0 else math.inf
+    if not (math.isfinite(steps) and steps <= MAX_STEPS):
+        r.problem(_at(line), f"MaxTime {sim.max_time:g} ms at a time step of {sim.dt:g} ms "
+                             f"is {steps:.3g} steps (at most {MAX_STEPS:.0e})")
 
 
 # ---- grid -----------------------------------------------------------------------
+MAX_CELLS = 10 ** 15      # cells along an axis counted before the memory check refuses them
+
+
 def _axis(lo: float, hi: float, axis: AxisModel) -> tuple[float, int]:
     """Cells along one axis; a cell size that does not divide the length extends the
     upper limit by one cell, as NairnMPM does."""
     if axis.cellsize is not None:
         cs = axis.cellsize
+        if not (hi - lo) / cs < MAX_CELLS:
+            # an absurd count is refused by its memory (``_check_size``), not here
+            return hi, MAX_CELLS
         n = int(math.floor((hi - lo) / cs + 1e-9))
-        if lo + n * cs < hi - 1e-9 * cs:
+        if n == 0 or lo + n * cs < hi - 1e-9 * cs:
             n += 1
-        return lo + n * cs, max(n, 1)
+        return lo + n * cs, n
     return hi, axis.n
 
 
@@ -125,13 +146,13 @@ def _check_size(r: Reader, model: InputModel, grid: Grid) -> None:
         return
     ppc = max([b.points_per_cell or model.mpm.points_per_cell for b in model.bodies]
               + [model.mpm.points_per_cell])
-    cell_area = grid.dx * grid.dy
     particles = 0.0
     for body in model.bodies:
         if not body.hole:
             for shape in body.shapes:
                 x0, x1, y0, y1 = _bbox(shape)
-                particles += (x1 - x0) * (y1 - y0) / cell_area * ppc
+                # per axis: a cell area can underflow to 0
+                particles += (x1 - x0) / grid.dx * ((y1 - y0) / grid.dy) * ppc
     particles = min(particles, grid.n_cells * ppc)
     need = (particles * BYTES_PER_PARTICLE + grid.n_nodes * BYTES_PER_NODE
             + grid.n_cells * ppc * BYTES_PER_CANDIDATE)

@@ -38,6 +38,7 @@ class MPMHeaderModel(Model):
     shape: Literal["linear", "uGIMP"] = "linear"
     max_time_ms: float = 1000.0          # NairnMPM's default maximum time is 1 s
     time_step_ms: float | None = None
+    max_time_line: int | None = None
     cfl: float = Field(0.5, gt=0)
     archive_time_ms: float | None = None
     archive_start_ms: float = 0.0

@@ -1,6 +1,8 @@
 """NairnMPM XML -> validated input model (all problems reported with their line)."""
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -116,7 +118,11 @@ def _time(r: Reader, el, value: float | None, units: str | None) -> float | None
         r.problem(el, f"<{el.tag}> units=\"{units}\" is not a known time unit "
                       "(use s, ms, msec, us or microsec)")
         return None
-    return value * TIME_UNITS_TO_MS[key]
+    ms = value * TIME_UNITS_TO_MS[key]
+    if not math.isfinite(ms):
+        r.problem(el, f"<{el.tag}> {value:g} {key or 's'} is too large a time")
+        return None
+    return ms
 
 
 def _positive_time(r: Reader, el, value: float | None, units: str | None,
@@ -156,6 +162,7 @@ def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
             end = _positive_time(r, c, a.get("max"), a.get("units"), "max")
             if end is not None:
                 h["max_time_ms"] = end
+                h["max_time_line"] = c.sourceline
             if "step" in a:
                 h["time_step_ms"] = _time(r, c, a["step"], a.get("units"))
             if "CFL" in a:
@@ -172,6 +179,8 @@ def _mpm_header(r: Reader, el) -> MPMHeaderModel | None:
                    "FirstArchiveTime": "archive_start_ms"}[tag]
             if v is not None:
                 h[key] = v
+                if tag == "MaxTime":
+                    h["max_time_line"] = c.sourceline
         elif tag == "ArchiveGroup":
             a = r.attrs(c, {"time": float, "start": float, "units": str, "maxProps": int},
                         required=("time",))
@@ -256,8 +265,9 @@ def _grid(r: Reader, el) -> GridModel | None:
                                     line=c.sourceline)
         else:
             r.unknown(c, "Grid")
-    if len(a) < 4 or "Horiz" not in axes or "Vert" not in axes:
-        if len(a) >= 4:
+    bounds = ("xmin", "xmax", "ymin", "ymax")
+    if any(k not in a for k in bounds) or "Horiz" not in axes or "Vert" not in axes:
+        if all(k in a for k in bounds):
             r.problem(el, "<Grid> needs <Horiz> and <Vert> children")
         return None
     if a["xmin"] == a["xmax"] or a["ymin"] == a["ymax"]:

@@ -6,6 +6,7 @@ once; an element or attribute we do not know is a problem, never silently skippe
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 
 from lxml import etree
@@ -46,7 +47,7 @@ class Reader:
                 self.problem(el, f"unsupported attribute '{name}' on <{el.tag}> (allowed: {allowed})")
                 continue
             try:
-                out[name] = conv(raw.strip())
+                out[name] = _finite(conv(raw.strip()))
             except (ValueError, TypeError):
                 self.problem(el, f"<{el.tag}> attribute {name}=\"{raw}\" is not a valid {_kind(conv)}")
         for name in required:
@@ -61,7 +62,7 @@ class Reader:
                 self.problem(el, f"<{el.tag}> needs a value")
             return None
         try:
-            return conv(raw)
+            return _finite(conv(raw))
         except (ValueError, TypeError):
             self.problem(el, f"<{el.tag}> value '{raw}' is not a valid {_kind(conv)}")
             return None
@@ -69,6 +70,14 @@ class Reader:
     def no_children(self, el) -> None:
         for c in self.children(el):
             self.unknown(c, el.tag)
+
+
+def _finite(value):
+    """NaN and infinity are no value of any input field (an infinite MaxTime or
+    modulus would only fail later, and less clearly)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError("not finite")
+    return value
 
 
 def _kind(conv) -> str:
@@ -88,6 +97,7 @@ def parse_file(path: str | Path):
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if getattr(exc, "lineno", None) else None
         msg = exc.msg if hasattr(exc, "msg") else str(exc)
+        msg = (msg.splitlines() or [""])[0].strip()    # one line (lxml may quote the text)
         if data.lstrip()[:1] != b"<":
             msg = "not an XML file (NairnMPM command scripts must be exported to XML first)"
         raise InputError(InputProblem(str(path), line, f"malformed XML: {msg}")) from None
