@@ -18,7 +18,7 @@ class Lists:
     def __init__(self):
         self.nslot = np.full((2, NNX * NNX), -1, dtype=np.int64)
         self.cstart = np.zeros((2, NCX * NCY), dtype=np.int64)
-        self.cnear = np.zeros(NCX * NCY, dtype=np.uint8)
+        self.cnear = np.zeros(NNX * NNX, dtype=np.uint8)
         self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)
 
     def build(self, c):
@@ -39,6 +39,14 @@ def _cell(x, y):
     return int(np.floor(y - GEOM[1])) * NCX + int(np.floor(x - GEOM[0]))
 
 
+def _origin(x, y, ugimp=True):
+    """A particle's first stencil node, as the shape functions find it."""
+    xi, yi = x - GEOM[0], y - GEOM[1]
+    if ugimp:
+        return (int(np.floor(yi + 0.5)) - 1) * NNX + int(np.floor(xi + 0.5)) - 1
+    return int(np.floor(yi)) * NNX + int(np.floor(xi))
+
+
 def _field(c, lists, x, y, nx, ny):
     node = int(round(ny - GEOM[1])) * NNX + int(round(nx - GEOM[0]))
     f, *_ = K._pair_field(x, y, nx, ny, node, _cell(x, y), lists.cstart, lists.chords, lists.cxy,
@@ -55,7 +63,7 @@ def test_chord_lists_cover_cells_near_the_crack_only_and_follow_it():
     q = lists.cstart[0, _cell(2.5, 2.5)]
     k = lists.chords[q]
     assert np.array_equal(lists.cxy[q], [c["cp"][0, k], c["cp"][1, k], c["cp"][0, k + 1], c["cp"][1, k + 1]])
-    assert lists.cnear[_cell(2.5, 4.5)] == 1 and lists.cnear[_cell(9.5, 9.5)] == 0
+    assert lists.cnear[_origin(2.5, 4.5)] == 1 and lists.cnear[_origin(9.5, 9.5)] == 0
     slotted = set(lists.cnodes.tolist())
     assert int(round(2.0 - GEOM[1])) * NNX + int(round(2.0 - GEOM[0])) in slotted
     # moved far away, the crack leaves nothing behind in its old cells and nodes
@@ -63,9 +71,28 @@ def test_chord_lists_cover_cells_near_the_crack_only_and_follow_it():
     lists.build(c)
     per_cell = lists.cstart[1] - lists.cstart[0]
     assert per_cell[_cell(2.5, 2.5)] == 0 and per_cell[_cell(2.5, 8.5)] == 2
-    assert lists.cnear[_cell(2.5, 2.5)] == 0
+    assert lists.cnear[_origin(2.5, 2.5)] == 0
     assert np.all(lists.nslot[0, : 3 * NNX] == -1)
     assert set(lists.cnodes.tolist()) == set(np.flatnonzero(lists.nslot[0] >= 0).tolist())
+
+
+def test_every_particle_that_touches_a_crack_node_is_marked_near():
+    """The far path (no crossing tests) must never see a crack node: every particle
+    whose stencil (uGIMP 3x3, linear 2x2 nodes) holds a slotted node has its first
+    stencil node marked in ``cnear``, whichever way the crack has moved."""
+    rng = np.random.default_rng(3)
+    c = _crack([1.2, 3.2, 5.2], 2.01)
+    lists = Lists()
+    for shift in (0.0, 3.3, 1.7):
+        c["cp"][1] = 2.01 + shift
+        lists.build(c)
+        slotted = lists.nslot[0] >= 0
+        for x, y in rng.uniform(0.05, 8.95, size=(4000, 2)):
+            for ugimp, na in ((True, 3), (False, 2)):
+                o = _origin(x, y, ugimp)
+                nodes = [o + b * NNX + a for b in range(na) for a in range(na)]
+                if slotted[nodes].any():
+                    assert lists.cnear[o] == 1, (x, y, ugimp)
 
 
 def test_field_is_one_across_the_crack_and_zero_beside_or_beyond_the_tip():

@@ -4,7 +4,7 @@ Numba passes a named tuple of arrays to a ``cache=True`` kernel as cheaply as th
 arrays themselves, so each task has the one signature ``task(P, G, C, K, S)``
 instead of dozens of positional arrays.  ``K`` is the crack bundle of a scene with
 cracks (``cracks.bundle``) or ``NO_CRACKS`` here; the core reads only its field
-choice (``vfld``, ``cut``, ``chunk_counts``, and ``cnear``: cells near a crack), and
+choice (``vfld``, ``cut``, ``chunk_counts``, and ``cnear``: stencil origins near a crack), and
 only in builds with more than one velocity field.
 
 Grid arrays carry a field axis: ``g[field, row, node]``.  A scene without cracks

@@ -16,7 +16,7 @@ CrackArrays = namedtuple("CrackArrays", [
     "claw", "cstate", "chist",         # traction law, state, largest opening per mode
     "law1", "law2",                    # law tables for mode I and II envelopes
     "vfld", "cut",                     # field of each particle at each node; 1 if any > 0
-    "nslot", "cstart", "cnear", "cbox",   # node slots, chords per cell, near cells, box
+    "nslot", "cstart", "cnear", "cbox",   # node slots, chords per cell, near origins, box
     "chords", "cxy", "cnodes", "cnodes_old",   # crack lists (capacity arrays)
     "nlist",                           # (3,) chords, crack nodes, old crack nodes in use
     "counts", "chunk_counts",          # counters (C_*) and per-chunk conflicts

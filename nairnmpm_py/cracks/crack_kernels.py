@@ -125,13 +125,12 @@ def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cn
     m at (x, y) with momentum (mvx, mvy)), then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
     side) onto its chunk buffer.  A particle in a cell with no chord within two cells
-    (``cnear`` 0) touches no crack node: field 0, no crossing tests, ``cut`` 0."""
+    (``cnear`` 0 at its first stencil node: ``crack_lists.NEAR_ORIGIN``) touches no
+    crack node: field 0, no crossing tests, ``cut`` 0."""
     nnx = int(geom[4])
-    ncx = nnx - 1               # cells per row (``CrackScene``)
-    cell = _cell_of(x, y, geom, ncx, cnear.size // ncx)
-    if cnear[cell] != 0:
+    if cnear[j0 * nnx + i0] != 0:
         return _assign_near_crack(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut,
-                                  cell, crack_lists, conflicts)
+                                  crack_lists, conflicts)
     cut[p] = 0
     # step_kernels.scatter_mass_momentum's loop, written here because this module's NA
     # is its own build's (the template's copy would always have uGIMP's 3)
@@ -149,13 +148,15 @@ def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cn
 
 
 @njit(cache=True, fastmath=FAST, error_model="numpy", no_cpython_wrapper=True)
-def _assign_near_crack(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cell,
+def _assign_near_crack(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut,
                        crack_lists, conflicts):
     """``assign_and_scatter`` of a particle near a crack: linked, not inlined (few
     particles take it, and inlined it made the particle pass compile for about 20 s
     longer); compiled like the particle pass that calls it."""
     nnx = int(geom[4])
     nslot, cstart, chords, cxy, ccrack, cp, use_position, pos0 = crack_lists
+    ncx = nnx - 1               # cells per row (``CrackScene``)
+    cell = _cell_of(x, y, geom, ncx, cstart.shape[1] // ncx)
     if use_position:
         mux = m * x
         muy = m * y

@@ -15,6 +15,14 @@ from .chords import _chord, _chord_cells
 # when a cell next to it lists a chord: particles farther than this from every
 # listed cell touch no crack node
 NEAR_CELLS = 2
+# ``cnear`` is indexed by a particle's first stencil node (i0, j0), which the particle
+# pass has at hand (its cell would cost two divisions per particle): with the cell
+# (ci, cj) at i0 or i0 + 1 (uGIMP: i0 = floor(x / dx + 0.5) - 1; linear: i0 = ci),
+# marking the nodes from NEAR_ORIGIN below to NEAR_CELLS above a listed cell marks
+# every particle within NEAR_CELLS of it, and more particles only ever take the near
+# path's code, which gives the far path's result for a particle that touches no crack
+# node (the same sums in the same order)
+NEAR_ORIGIN = NEAR_CELLS + 1
 
 
 @njit(cache=True)
@@ -28,8 +36,9 @@ def build_crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, n
     follows the crack, not the grid.  ``cstart[0, cell]`` to ``cstart[1, cell]`` index
     the cell's chords in the returned ``chords``; every other cell has an empty range.
     ``cxy`` holds each entry's chord end points.
-    ``cnear`` marks cells within NEAR_CELLS of a cell with chords; ``nslot`` holds a
-    node's two lowest-numbered cracks listed in a cell next to it (-1 none).
+    ``cnear`` marks the stencil origins (nodes) of particles within NEAR_CELLS of a
+    cell with chords (see NEAR_ORIGIN); ``nslot`` holds a node's two lowest-numbered
+    cracks listed in a cell next to it (-1 none).
     """
     px = cp[0]
     py = cp[1]
@@ -42,7 +51,9 @@ def build_crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, n
                 cell = j * ncx + i
                 cstart[0, cell] = 0
                 cstart[1, cell] = 0
-                cnear[cell] = 0
+        for j in range(max(cbox[2] - NEAR_ORIGIN, 0), min(cbox[3] + NEAR_CELLS + 1, nny)):
+            for i in range(max(cbox[0] - NEAR_ORIGIN, 0), min(cbox[1] + NEAR_CELLS + 1, nnx)):
+                cnear[j * nnx + i] = 0
         for j in range(cbox[2], min(cbox[3] + 2, nny)):
             for i in range(cbox[0], min(cbox[1] + 2, nnx)):
                 nslot[0, j * nnx + i] = -1
@@ -103,9 +114,9 @@ def build_crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, n
             cell = j * ncx + i
             if cstart[1, cell] == cstart[0, cell]:
                 continue
-            for jj in range(max(j - NEAR_CELLS, 0), min(j + NEAR_CELLS + 1, ncy)):
-                for ii in range(max(i - NEAR_CELLS, 0), min(i + NEAR_CELLS + 1, ncx)):
-                    cnear[jj * ncx + ii] = 1
+            for jj in range(max(j - NEAR_ORIGIN, 0), min(j + NEAR_CELLS + 1, nny)):
+                for ii in range(max(i - NEAR_ORIGIN, 0), min(i + NEAR_CELLS + 1, nnx)):
+                    cnear[jj * nnx + ii] = 1
     cnodes = np.empty((bw + 1) * (j_hi - j_lo + 2), dtype=np.int64)
     for j in range(j_lo, min(j_hi + 2, nny)):
         for i in range(i_lo, min(i_hi + 2, nnx)):

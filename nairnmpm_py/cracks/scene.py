@@ -128,7 +128,7 @@ class CrackScene:
         self.nslot = np.full((2, nn), -1, dtype=np.int64)
         ncells = (sim.grid.nodes_x - 1) * (sim.grid.nodes_y - 1)
         self.cstart = np.zeros((2, ncells), dtype=np.int64)   # chords of a cell (kernel)
-        self.cnear = np.zeros(ncells, dtype=np.uint8)
+        self.cnear = np.zeros(nn, dtype=np.uint8)   # by stencil origin (``crack_lists``)
         self.cbox = np.array([0, -1, 0, -1], dtype=np.int64)    # cells the lists cover
         self.chunk_counts = np.zeros(sim.nch, dtype=np.int64)
         self.cnodes = np.zeros(nn, dtype=np.int64)             # crack lists (see bundle)
