@@ -124,9 +124,9 @@ def assign_and_scatter(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut, cn
     """Field choice at each node of particle p (weights ``r`` from node (i0, j0); mass
     m at (x, y) with momentum (mvx, mvy)), then its mass and momentum (and at crack
     nodes its displacement or position, and for crossed pairs the crack normal and
-    side) onto its chunk buffer.  A particle in a cell with no chord within two cells
-    (``cnear`` 0 at its first stencil node: ``crack_lists.NEAR_ORIGIN``) touches no
-    crack node: field 0, no crossing tests, ``cut`` 0."""
+    side) onto its chunk buffer.  A particle that can touch no crack node (``cnear`` 0
+    at its first stencil node: ``crack_lists.ORIGIN_BELOW``) takes field 0 at every
+    node, with no crossing tests, and ``cut`` 0."""
     nnx = int(geom[4])
     if cnear[j0 * nnx + i0] != 0:
         return _assign_near_crack(buf, p, r, i0, j0, geom, m, x, y, mvx, mvy, vfld, cut,

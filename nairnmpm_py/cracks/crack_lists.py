@@ -11,18 +11,14 @@ from numba import njit
 
 from .chords import _chord, _chord_cells
 
-# a particle's nodes are within two cells of its cell, and a node has a crack slot
-# when a cell next to it lists a chord: particles farther than this from every
-# listed cell touch no crack node
-NEAR_CELLS = 2
-# ``cnear`` is indexed by a particle's first stencil node (i0, j0), which the particle
-# pass has at hand (its cell would cost two divisions per particle): with the cell
-# (ci, cj) at i0 or i0 + 1 (uGIMP: i0 = floor(x / dx + 0.5) - 1; linear: i0 = ci),
-# marking the nodes from NEAR_ORIGIN below to NEAR_CELLS above a listed cell marks
-# every particle within NEAR_CELLS of it, and more particles only ever take the near
-# path's code, which gives the far path's result for a particle that touches no crack
-# node (the same sums in the same order)
-NEAR_ORIGIN = NEAR_CELLS + 1
+# ``cnear`` is indexed by a particle's first stencil node i0 (and j0), which the
+# particle pass has at hand (its cell would cost two divisions per particle).  The
+# particle touches nodes i0 .. i0 + 2 (uGIMP; i0 .. i0 + 1 linear), and the nodes
+# with a crack slot are those of the cells that list a chord (i .. i + 1): so only
+# particles with i0 in [i - ORIGIN_BELOW, i + ORIGIN_ABOVE] can touch one.  Those
+# take the near path (crossing tests); every other particle touches no crack node.
+ORIGIN_BELOW = 2
+ORIGIN_ABOVE = 1
 
 
 @njit(cache=True)
@@ -36,23 +32,23 @@ def build_crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, n
     follows the crack, not the grid.  ``cstart[0, cell]`` to ``cstart[1, cell]`` index
     the cell's chords in the returned ``chords``; every other cell has an empty range.
     ``cxy`` holds each entry's chord end points.
-    ``cnear`` marks the stencil origins (nodes) of particles within NEAR_CELLS of a
-    cell with chords (see NEAR_ORIGIN); ``nslot`` holds a node's two lowest-numbered
-    cracks listed in a cell next to it (-1 none).
+    ``cnear`` marks the stencil origins (first nodes) of the particles that can touch
+    a node of a cell with chords (ORIGIN_BELOW, ORIGIN_ABOVE); ``nslot`` holds a
+    node's two lowest-numbered cracks listed in a cell next to it (-1 none).
     """
     px = cp[0]
     py = cp[1]
     nn = nslot.shape[1]
     nny = nn // nnx
-    # clear the previous box (cells with their near margin, nodes of those cells)
+    # clear the previous box (its cells, the origins near them, the nodes of its cells)
     if cbox[0] <= cbox[1]:
-        for j in range(max(cbox[2] - NEAR_CELLS, 0), min(cbox[3] + NEAR_CELLS + 1, ncy)):
-            for i in range(max(cbox[0] - NEAR_CELLS, 0), min(cbox[1] + NEAR_CELLS + 1, ncx)):
+        for j in range(cbox[2], cbox[3] + 1):
+            for i in range(cbox[0], cbox[1] + 1):
                 cell = j * ncx + i
                 cstart[0, cell] = 0
                 cstart[1, cell] = 0
-        for j in range(max(cbox[2] - NEAR_ORIGIN, 0), min(cbox[3] + NEAR_CELLS + 1, nny)):
-            for i in range(max(cbox[0] - NEAR_ORIGIN, 0), min(cbox[1] + NEAR_CELLS + 1, nnx)):
+        for j in range(max(cbox[2] - ORIGIN_BELOW, 0), min(cbox[3] + ORIGIN_ABOVE + 1, nny)):
+            for i in range(max(cbox[0] - ORIGIN_BELOW, 0), min(cbox[1] + ORIGIN_ABOVE + 1, nnx)):
                 cnear[j * nnx + i] = 0
         for j in range(cbox[2], min(cbox[3] + 2, nny)):
             for i in range(cbox[0], min(cbox[1] + 2, nnx)):
@@ -114,8 +110,8 @@ def build_crack_lists(cp, cfirst, clast, cext0, cext1, ccrack, geom, ncx, ncy, n
             cell = j * ncx + i
             if cstart[1, cell] == cstart[0, cell]:
                 continue
-            for jj in range(max(j - NEAR_ORIGIN, 0), min(j + NEAR_CELLS + 1, nny)):
-                for ii in range(max(i - NEAR_ORIGIN, 0), min(i + NEAR_CELLS + 1, nnx)):
+            for jj in range(max(j - ORIGIN_BELOW, 0), min(j + ORIGIN_ABOVE + 1, nny)):
+                for ii in range(max(i - ORIGIN_BELOW, 0), min(i + ORIGIN_ABOVE + 1, nnx)):
                     cnear[jj * nnx + ii] = 1
     cnodes = np.empty((bw + 1) * (j_hi - j_lo + 2), dtype=np.int64)
     for j in range(j_lo, min(j_hi + 2, nny)):
