@@ -9,8 +9,8 @@
   carried stress half), of its particles and, in a scene with cracks, of the crack
   scene and its crack set (traction histories, edge maxima, crack lists);
 * ``state``: JSON of the Python-side state: whether the grid holds the current
-  extrapolation, each tip's growth count and why it stopped, the notch roots, the
-  growth log, global.csv's load groups.
+  extrapolation, global.csv's load groups and the crack scene's own
+  (``CrackScene.checkpoint_state``: tips' growth, notch roots, growth log).
 
 A checkpoint is taken between driver calls, after that call's outputs, so the state
 and the files written agree.  It is written to a temporary file, flushed to disk and
@@ -45,20 +45,13 @@ def _owners(sim) -> dict:
 
 
 def _python_state(sim) -> dict:
-    state = {"step": int(sim.step), "time": float(sim.time),
-             "grid_current": bool(sim.grid_current),
+    state = {"grid_current": bool(sim.grid_current),
              # global.csv's load groups are found once, at the first row (the resume
              # rebuilds them from these: the grown cracks could split them otherwise)
              "couples": None if sim.couples is None else
              [[c.name, [int(r) for r in c.records]] for c in sim.couples]}
-    scene = sim.cracks
-    if scene is not None:
-        state["tips"] = [{"crack": t.crack, "end": t.end, "grown": t.grown,
-                          "stopped": t.stopped} for t in scene.tips]
-        state["initial_root"] = [[c, end, int(pid)] for (c, end), pid in
-                                 scene.initial_root.items()]
-        state["growth_log"] = scene.growth_log
-        state["full_checks"] = int(scene.full_checks)
+    if sim.cracks is not None:
+        state["cracks"] = sim.cracks.checkpoint_state()
     return state
 
 
@@ -144,20 +137,11 @@ def restore(sim, ck: Checkpoint) -> None:
         sim.bad[:] = 0
         sim.bad[:, 0] = -1
         sim.bad[0, 2] = int(ck.arrays["sim"]["bad"][:, 2].sum())
-    state = ck.state
-    sim.step = int(state["step"])
-    sim.time = float(state["time"])
-    sim.grid_current = bool(state["grid_current"])
-    scene = sim.cracks
-    if scene is not None:
-        for tip, saved in zip(scene.tips, state["tips"]):
-            if (tip.crack, tip.end) != (saved["crack"], saved["end"]):
-                raise ValueError(f"{ck.path}: crack tips differ from the input's")
-            tip.grown, tip.stopped = int(saved["grown"]), str(saved["stopped"])
-        scene.initial_root = {(c, end): pid for c, end, pid in state["initial_root"]}
-        scene.growth_log = list(state["growth_log"])
-        scene.full_checks = int(state["full_checks"])
-        scene._subset_window = None
+    sim.step = ck.step
+    sim.time = ck.time_ms
+    sim.grid_current = bool(ck.state["grid_current"])
+    if sim.cracks is not None:
+        sim.cracks.restore_checkpoint_state(ck.state["cracks"], str(ck.path))
 
 
 class Checkpoints:

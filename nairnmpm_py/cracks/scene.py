@@ -529,6 +529,25 @@ class CrackScene:
         sim.grid_current = False
         return True
 
+    # ---- checkpoints (``core.checkpoint``: the arrays are saved from outside) ---------
+    def checkpoint_state(self) -> dict:
+        """What a checkpoint needs besides this scene's arrays (JSON-ready)."""
+        return {"tips": [{"crack": t.crack, "end": t.end, "grown": t.grown,
+                          "stopped": t.stopped} for t in self.tips],
+                "initial_root": [[c, end, int(pid)] for (c, end), pid in
+                                 self.initial_root.items()],
+                "growth_log": self.growth_log, "full_checks": int(self.full_checks)}
+
+    def restore_checkpoint_state(self, state: dict, where: str) -> None:
+        for tip, saved in zip(self.tips, state["tips"]):
+            if (tip.crack, tip.end) != (saved["crack"], saved["end"]):
+                raise ValueError(f"{where}: crack tips differ from the input's")
+            tip.grown, tip.stopped = int(saved["grown"]), str(saved["stopped"])
+        self.initial_root = {(c, end): pid for c, end, pid in state["initial_root"]}
+        self.growth_log = list(state["growth_log"])
+        self.full_checks = int(state["full_checks"])
+        self._subset_window = None     # found again for the restored particles
+
     def rcurve_theory(self, sim, points: int = 121) -> list[dict]:
         """For each growing tip whose new crack particles get a traction law: R against
         the opening at the notch root by seed Eq 16 (Eq 22 for the cubic law), the law

@@ -60,6 +60,10 @@ class ArchiveH5(OutputPlugin):
         return self.folder / self.filename
 
     def begin(self, sim) -> None:
+        self._start(sim)
+        self._write_index()
+
+    def _start(self, sim) -> None:
         g = sim.grid
         self.attrs = {"title": getattr(sim, "title", "") or "", "units": UNITS,
                       "plane_stress": bool(sim.plane_stress),
@@ -71,7 +75,6 @@ class ArchiveH5(OutputPlugin):
         self.input_text = (getattr(sim, "source", None) or {}).get("text", "") or ""
         self.steps = []
         (self.folder / FOLDER).mkdir(exist_ok=True)
-        self._write_index()
 
     def _write_index(self) -> None:
         tmp = aside(self.path)
@@ -118,8 +121,9 @@ class ArchiveH5(OutputPlugin):
 
     def resume(self, sim, step: int, time_ms: float) -> None:
         """Archives after the checkpoint's step (a run that went on past it) are
-        dropped; new ones are added."""
-        self.begin(sim)
+        dropped; new ones are added.  The index is rewritten once, with the kept
+        ones: a kill during the resume leaves it whole."""
+        self._start(sim)
         for path in (self.folder / FOLDER).glob("*.tmp"):    # a write that was cut off
             path.unlink()
         for path in sorted((self.folder / FOLDER).glob("*.h5")):

@@ -38,18 +38,21 @@ class OutputPlugin:
         self.begin(sim)
 
 
-def keep_csv_rows(path: Path, keep) -> list[str]:
+def keep_csv_rows(path: Path, column: str, keep) -> list[str]:
     """Rewrite the CSV ``path`` with its header and the complete rows (ending in a
-    newline: a killed run may leave half a row) for which ``keep(cells)`` is true;
-    returns the header's columns ([] if there is no file).  Atomic: a reader never
-    sees half the file."""
+    newline: a killed run may leave half a row) whose ``column`` cell passes
+    ``keep(text)``; returns the header's columns ([] if there is no file or no such
+    column: nothing is rewritten).  Atomic: a reader never sees half the file."""
     if not path.exists():
         return []
     lines = path.read_text().splitlines(keepends=True)
     if not lines or not lines[0].endswith("\n"):
         return []
     header = lines[0].rstrip("\n").split(",")
-    rows = [ln for ln in lines[1:] if ln.endswith("\n") and keep(ln.rstrip("\n").split(","))]
+    if column not in header:
+        return []
+    at = header.index(column)
+    rows = [ln for ln in lines[1:] if ln.endswith("\n") and keep(ln.rstrip("\n").split(",")[at])]
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text("".join([lines[0]] + rows))
     os.replace(tmp, path)

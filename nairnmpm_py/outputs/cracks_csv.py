@@ -88,7 +88,7 @@ class CracksCsv(OutputPlugin):
         files = []
         for name in names:
             path = self.folder / name
-            if keep_csv_rows(path, lambda cells: float(cells[0]) <= late) == COLUMNS:
+            if keep_csv_rows(path, "time_ms", lambda cell: float(cell) <= late) == COLUMNS:
                 files.append(_CsvFile(path, append=True))
             else:
                 files.append(_CsvFile(path))

@@ -41,16 +41,7 @@ class GlobalCsv(OutputPlugin):
 
     def resume(self, sim, step: int, time_ms: float) -> None:
         path = self.folder / self.filename
-        at = {}
-
-        def keep(cells):
-            return int(cells[at["step"]]) <= step
-        header = []
-        if path.exists():
-            first = path.read_text().split("\n", 1)[0].split(",")
-            if "step" in first:
-                at["step"] = first.index("step")
-                header = keep_csv_rows(path, keep)
+        header = keep_csv_rows(path, "step", lambda cell: int(cell) <= step)
         if not header:
             self.begin(sim)
             return
